@@ -1,0 +1,41 @@
+// Pure (free) inertial navigation over an IMU record: the strapdown mechanization from
+// an initial state, the solution written at every IMU epoch (or a chosen interval), and,
+// when a reference trajectory is given, its errors.
+#pragma once
+
+#include <functional>
+#include <optional>
+
+#include "core/io/sample_reader.h"
+#include "core/strapdown.h"
+#include "problems/ins/nav_error.h"
+
+namespace navtwin {
+
+struct PureInsOptions {
+  StrapdownOptions strapdown;
+  /// Write the solution every this many seconds (0: at every IMU epoch).
+  double output_interval_s = 0.0;
+  /// Stop after this time (inf: the end of the IMU record).
+  double end_time_s = std::numeric_limits<double>::infinity();
+  /// Progress on stderr every this many IMU samples (0: none).
+  std::size_t progress_every = 0;
+};
+
+struct PureInsResult {
+  std::size_t imu_samples = 0;   ///< samples mechanized
+  std::size_t skipped_before_start = 0;
+  NavState final_state;
+  std::optional<NavErrorStats> errors;  ///< when a truth reader was given and overlapped
+  double run_time_s = 0.0;
+};
+
+/// Runs the mechanization from `initial` over the IMU samples with t_s > initial.t_s.
+/// `output` (may be empty) receives the solution at the output epochs. `truth` (may be
+/// null) is compared at each of its epochs inside the run, interpolating the solution
+/// between IMU epochs. Throws InputError on bad input.
+PureInsResult RunPureIns(ImuReader& imu, const NavState& initial, const PureInsOptions& options,
+                         const std::function<void(const NavState&)>& output,
+                         NavReader* truth = nullptr);
+
+}  // namespace navtwin

@@ -1,0 +1,55 @@
+#include "core/sim/analytic_trajectory.h"
+
+#include <gtest/gtest.h>
+
+#include "core/rotation.h"
+#include "core/strapdown.h"
+
+namespace navtwin::sim {
+namespace {
+
+// The mechanization on the exact increments of the demo flight must reproduce the truth:
+// this checks the synthesis and the strapdown against each other over 10 min of
+// manoeuvres at 100 Hz.
+TEST(AnalyticTrajectory, MechanizationReproducesDemoFlightTruth) {
+  DemoFlight flight;
+  std::unique_ptr<Strapdown> ins;
+  NavState truth_end;
+  double max_pos_err_m = 0.0, max_att_err_rad = 0.0;
+  SynthesizeImu(flight, {37.5 * kDegToRad, 127.0 * kDegToRad, 500.0}, 100.0, 600.0,
+                [&](const ImuSample& imu, const NavState& truth) {
+                  if (!ins) {
+                    ins = std::make_unique<Strapdown>(truth);
+                    return;
+                  }
+                  ins->Update(imu);
+                  const NavState& s = ins->state();
+                  max_pos_err_m = std::max(
+                      max_pos_err_m,
+                      wgs84::GeodeticToNed({s.lat_rad, s.lon_rad, s.h_m},
+                                           {truth.lat_rad, truth.lon_rad, truth.h_m})
+                          .norm());
+                  max_att_err_rad =
+                      std::max(max_att_err_rad, AttitudeError(truth.q_n_b, s.q_n_b).norm());
+                  truth_end = truth;
+                });
+  EXPECT_NEAR(truth_end.t_s, 600.0, 1e-9);
+  // Bounds: the issue-3 round-trip targets (1 cm, 1e-4 deg) scaled to this shorter flight.
+  EXPECT_LT(max_pos_err_m, 0.01);
+  EXPECT_LT(max_att_err_rad * kRadToDeg, 1e-4);
+}
+
+TEST(AnalyticTrajectory, SpecificForceAtRestIsMinusGravity) {
+  struct Still : AnalyticTrajectory {
+    Eigen::Vector3d Euler_rad(double) const override { return Eigen::Vector3d::Zero(); }
+    Eigen::Vector3d EulerRate_rad_s(double) const override { return Eigen::Vector3d::Zero(); }
+    Eigen::Vector3d Velocity_n_mps(double) const override { return Eigen::Vector3d::Zero(); }
+    Eigen::Vector3d Acceleration_n_mps2(double) const override { return Eigen::Vector3d::Zero(); }
+  } still;
+  const BodyKinematics k = BodyKinematicsAt(still, 0.0, 0.3, 10.0);
+  EXPECT_NEAR(k.f_b_mps2.z(), -wgs84::NormalGravity(0.3, 10.0), 1e-12);
+  EXPECT_NEAR((k.omega_ib_b_rad_s - wgs84::EarthRateNed(0.3)).norm(), 0.0, 1e-18);
+}
+
+}  // namespace
+}  // namespace navtwin::sim
