@@ -48,7 +48,8 @@ std::vector<std::string> ForeignFlags(const Command& c) {
   gflags::GetAllFlags(&all);
   std::vector<std::string> foreign;
   for (const auto& f : all) {
-    if (f.is_default || f.name == "format") continue;
+    // Compared as text: is_default is false for a NaN default (NaN != NaN).
+    if (f.current_value == f.default_value || f.name == "format") continue;
     const bool ours = std::find(c.flags.begin(), c.flags.end(), f.name) != c.flags.end();
     // Only the flags defined by this program are policed (not glog's own).
     if (!ours && f.filename.find("apps/navtwin/") != std::string::npos) foreign.push_back(f.name);

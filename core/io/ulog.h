@@ -109,9 +109,9 @@ class ULogFile {
 
   // What the file said so far.
   const std::string& path() const;
-  int version() const;                                    ///< header format version
-  const std::map<std::string, std::string>& info() const;  ///< 'I': name -> value as text
-  const std::map<std::string, double>& parameters() const; ///< 'P': name -> latest value
+  int version() const;                                      ///< header format version
+  const std::map<std::string, std::string>& info() const;   ///< 'I': name -> value as text
+  const std::map<std::string, double>& parameters() const;  ///< 'P': name -> latest value
   const std::vector<ULogSubscription>& subscriptions() const;
   const std::vector<ULogLoggedString>& logged_strings() const;
   std::size_t dropout_count() const;

@@ -37,6 +37,17 @@ class TruthComparer {
 
 }  // namespace
 
+NavState InitialStateFromNav(NavReader& nav, std::optional<double> start_s) {
+  constexpr double kSameEpoch_s = 1e-6;
+  NavState s;
+  while (nav.Next(&s)) {
+    if (!start_s || s.t_s >= *start_s - kSameEpoch_s) return s;
+  }
+  throw InputError(nav.path(), 0, "sow",
+                   start_s ? "no record at or after the start time " + std::to_string(*start_s) + " s"
+                           : std::string("no navigation record in the file"));
+}
+
 PureInsResult RunPureIns(ImuReader& imu, const NavState& initial, const PureInsOptions& options,
                          const std::function<void(const NavState&)>& output, NavReader* truth) {
   const auto wall_start = std::chrono::steady_clock::now();

@@ -30,6 +30,11 @@ struct PureInsResult {
   double run_time_s = 0.0;
 };
 
+/// The initial state from a navigation file: the first record at or after start_s
+/// (within 1 us), or the first record when start_s is not given. Throws InputError when
+/// the file holds no such record.
+NavState InitialStateFromNav(NavReader& nav, std::optional<double> start_s);
+
 /// Runs the mechanization from `initial` over the IMU samples with t_s > initial.t_s.
 /// `output` (may be empty) receives the solution at the output epochs. `truth` (may be
 /// null) is compared at each of its epochs inside the run, interpolating the solution

@@ -1,0 +1,273 @@
+#include "core/io/kfgins.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include "core/io/input_error.h"
+#include "core/io/rate_to_increment.h"
+#include "core/io/text_reader.h"
+#include "core/rotation.h"
+
+namespace navtwin {
+namespace {
+
+constexpr double kSecondsPerWeek = 604800.0;
+
+/// Numeric rows of a KF-GINS file: blank and '#' lines skipped, fields split, the column
+/// count checked against the first row (which must be one of the allowed counts).
+class Rows {
+ public:
+  Rows(const std::string& path, std::vector<std::size_t> allowed)
+      : lines_(path), allowed_(std::move(allowed)) {}
+
+  bool Next() {
+    while (lines_.Next(&line_)) {
+      if (IsBlank(line_) || Trim(line_).front() == '#') continue;
+      SplitLoose(line_, &fields_);
+      CheckCount();
+      return true;
+    }
+    return false;
+  }
+  double Get(std::size_t i, const char* field) const {
+    return ParseDouble(fields_[i], path(), line(), field);
+  }
+  std::string_view Text(std::size_t i) const { return fields_[i]; }
+  std::size_t size() const { return fields_.size(); }
+  long line() const { return lines_.line_number(); }
+  const std::string& path() const { return lines_.path(); }
+  /// Throws the "empty file" error; readers call it when the first Next() fails.
+  [[noreturn]] void ThrowEmpty() const {
+    throw InputError(path(), 0, "", "no samples (the file is empty)");
+  }
+
+ private:
+  void CheckCount() {
+    if (count_ == 0) {
+      for (std::size_t n : allowed_) {
+        if (fields_.size() == n) count_ = n;
+      }
+      if (count_ == 0) {
+        std::string expected;
+        for (std::size_t n : allowed_)
+          expected += (expected.empty() ? "" : " or ") + std::to_string(n);
+        throw InputError(
+            path(), line(), "",
+            "expected " + expected + " columns, found " + std::to_string(fields_.size()));
+      }
+      return;
+    }
+    RequireFieldCount(fields_.size(), count_, path(), line());
+  }
+
+  LineReader lines_;
+  std::vector<std::size_t> allowed_;
+  std::size_t count_ = 0;
+  std::string line_;
+  std::vector<std::string_view> fields_;
+};
+
+double LatitudeRad(const Rows& rows, std::size_t i) {
+  const double lat_deg = rows.Get(i, "lat");
+  if (std::fabs(lat_deg) > 90.0) {
+    throw InputError(rows.path(), rows.line(), "lat", "latitude beyond +-90 deg");
+  }
+  return lat_deg * kDegToRad;
+}
+
+Eigen::Vector3d Triple(const Rows& rows, std::size_t first, const char* x, const char* y,
+                       const char* z) {
+  return Eigen::Vector3d(rows.Get(first, x), rows.Get(first + 1, y), rows.Get(first + 2, z));
+}
+
+Eigen::Vector3d Sigmas(const Rows& rows, std::size_t first, const char* x, const char* y,
+                       const char* z) {
+  const Eigen::Vector3d s = Triple(rows, first, x, y, z);
+  const char* names[3] = {x, y, z};
+  for (int k = 0; k < 3; ++k) RequirePositive(s[k], rows.path(), rows.line(), names[k]);
+  return s;
+}
+
+class KfginsImuReader final : public ImuReader {
+ public:
+  explicit KfginsImuReader(const std::string& path) : rows_(path, {7}) {}
+
+  bool Next(ImuSample* sample) override {
+    while (rows_.Next()) {
+      ImuSample row;
+      row.t_s = rows_.Get(0, "t");
+      time_.Check(row.t_s, path(), rows_.line(), "t");
+      row.dtheta_b_rad = Triple(rows_, 1, "dtheta_x", "dtheta_y", "dtheta_z");
+      row.dv_b_mps = Triple(rows_, 4, "dv_x", "dv_y", "dv_z");
+      if (intervals_.Add(row, sample)) return true;
+    }
+    if (intervals_.rows() == 0) rows_.ThrowEmpty();
+    if (intervals_.rows() == 1) {
+      throw InputError(path(), rows_.line(), "t",
+                       "a single IMU sample: its interval is taken from the second sample's, "
+                       "so at least two lines are needed");
+    }
+    return intervals_.Flush(sample);
+  }
+  const std::string& path() const override { return rows_.path(); }
+
+ private:
+  Rows rows_;
+  IncreasingTime time_;
+  IncrementIntervals intervals_;
+};
+
+class KfginsGnssReader final : public GnssReader {
+ public:
+  explicit KfginsGnssReader(const std::string& path) : rows_(path, {7, 13}) {
+    if (!rows_.Next()) rows_.ThrowEmpty();
+    have_row_ = true;
+  }
+
+  bool Next(GnssSample* s) override {
+    if (!have_row_ && !rows_.Next()) return false;
+    have_row_ = false;
+    *s = GnssSample();
+    s->t_s = rows_.Get(0, "t");
+    time_.Check(s->t_s, path(), rows_.line(), "t");
+    s->lat_rad = LatitudeRad(rows_, 1);
+    s->lon_rad = rows_.Get(2, "lon") * kDegToRad;
+    s->h_m = rows_.Get(3, "h");
+    s->pos_std_ned_m = Sigmas(rows_, 4, "sigma_n", "sigma_e", "sigma_d");
+    if (rows_.size() == 13) {
+      s->has_velocity = true;
+      s->v_n_mps = Triple(rows_, 7, "v_n", "v_e", "v_d");
+      s->vel_std_ned_mps = Sigmas(rows_, 10, "sigma_vn", "sigma_ve", "sigma_vd");
+    }
+    return true;
+  }
+  const std::string& path() const override { return rows_.path(); }
+
+ private:
+  Rows rows_;
+  IncreasingTime time_;
+  bool have_row_ = false;
+};
+
+class KfginsNavReader final : public NavReader {
+ public:
+  explicit KfginsNavReader(const std::string& path) : rows_(path, {11}) {
+    if (!rows_.Next()) rows_.ThrowEmpty();
+    have_row_ = true;
+  }
+
+  bool Next(NavState* s) override {
+    if (!have_row_ && !rows_.Next()) return false;
+    have_row_ = false;
+    *s = NavState();
+    s->gps_week = ParseWholeNumber(rows_.Text(0), path(), rows_.line(), "week");
+    if (s->gps_week < 0) throw InputError(path(), rows_.line(), "week", "negative GPS week");
+    s->t_s = rows_.Get(1, "sow");
+    time_.Check(s->gps_week * kSecondsPerWeek + s->t_s, path(), rows_.line(), "sow");
+    s->lat_rad = LatitudeRad(rows_, 2);
+    s->lon_rad = rows_.Get(3, "lon") * kDegToRad;
+    s->h_m = rows_.Get(4, "h");
+    s->v_n_mps = Triple(rows_, 5, "v_n", "v_e", "v_d");
+    const Eigen::Vector3d euler_deg = Triple(rows_, 8, "roll", "pitch", "yaw");
+    s->q_n_b = QuatFromEuler(euler_deg.x() * kDegToRad, euler_deg.y() * kDegToRad,
+                             euler_deg.z() * kDegToRad);
+    return true;
+  }
+  const std::string& path() const override { return rows_.path(); }
+
+ private:
+  Rows rows_;
+  IncreasingTime time_;
+  bool have_row_ = false;
+};
+
+void RequireFinite(double v, const char* what) {
+  if (!std::isfinite(v)) throw std::invalid_argument(std::string("non-finite ") + what);
+}
+
+void RequireFinite(const Eigen::Vector3d& v, const char* what) {
+  if (!v.allFinite()) throw std::invalid_argument(std::string("non-finite ") + what);
+}
+
+void RequireSigma(const Eigen::Vector3d& s, const char* what) {
+  RequireFinite(s, what);
+  if (!(s.minCoeff() > 0.0)) throw std::invalid_argument(std::string(what) + " must be > 0");
+}
+
+void WriteTriple(std::ostream& os, const Eigen::Vector3d& v) {
+  os << ' ' << v.x() << ' ' << v.y() << ' ' << v.z();
+}
+
+}  // namespace
+
+std::unique_ptr<ImuReader> OpenKfginsImu(const std::string& path) {
+  return std::make_unique<KfginsImuReader>(path);
+}
+std::unique_ptr<GnssReader> OpenKfginsGnss(const std::string& path) {
+  return std::make_unique<KfginsGnssReader>(path);
+}
+std::unique_ptr<NavReader> OpenKfginsNav(const std::string& path) {
+  return std::make_unique<KfginsNavReader>(path);
+}
+
+KfginsImuWriter::KfginsImuWriter(const std::string& path) : file_(path) {}
+
+void KfginsImuWriter::Write(const ImuSample& s) {
+  RequireFinite(s.t_s, "IMU time");
+  RequireFinite(s.dtheta_b_rad, "dtheta");
+  RequireFinite(s.dv_b_mps, "dv");
+  std::ostream& os = file_.stream();
+  os << s.t_s;
+  WriteTriple(os, s.dtheta_b_rad);
+  WriteTriple(os, s.dv_b_mps);
+  os << '\n';
+}
+
+void KfginsImuWriter::Commit() { file_.Commit(); }
+
+KfginsGnssWriter::KfginsGnssWriter(const std::string& path) : file_(path) {}
+
+void KfginsGnssWriter::Write(const GnssSample& s) {
+  const int columns = s.has_velocity ? 13 : 7;
+  if (columns_ == 0) columns_ = columns;
+  if (columns != columns_) {
+    throw std::invalid_argument("KF-GINS GNSS file: samples with and without velocity mixed");
+  }
+  RequireFinite(s.t_s, "GNSS time");
+  RequireFinite(Eigen::Vector3d(s.lat_rad, s.lon_rad, s.h_m), "GNSS position");
+  RequireSigma(s.pos_std_ned_m, "GNSS position sigma");
+  std::ostream& os = file_.stream();
+  os << s.t_s << ' ' << s.lat_rad * kRadToDeg << ' ' << s.lon_rad * kRadToDeg << ' ' << s.h_m;
+  WriteTriple(os, s.pos_std_ned_m);
+  if (s.has_velocity) {
+    RequireFinite(s.v_n_mps, "GNSS velocity");
+    RequireSigma(s.vel_std_ned_mps, "GNSS velocity sigma");
+    WriteTriple(os, s.v_n_mps);
+    WriteTriple(os, s.vel_std_ned_mps);
+  }
+  os << '\n';
+}
+
+void KfginsGnssWriter::Commit() { file_.Commit(); }
+
+KfginsNavWriter::KfginsNavWriter(const std::string& path) : file_(path) {}
+
+void KfginsNavWriter::Write(const NavState& s) {
+  RequireFinite(s.t_s, "navigation time");
+  RequireFinite(Eigen::Vector3d(s.lat_rad, s.lon_rad, s.h_m), "navigation position");
+  RequireFinite(s.v_n_mps, "navigation velocity");
+  RequireFinite(s.q_n_b.coeffs().head<3>(), "attitude quaternion");
+  const Eigen::Vector3d euler_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
+  std::ostream& os = file_.stream();
+  os << (s.gps_week < 0 ? 0 : s.gps_week) << ' ' << s.t_s << ' ' << s.lat_rad * kRadToDeg << ' '
+     << s.lon_rad * kRadToDeg << ' ' << s.h_m;
+  WriteTriple(os, s.v_n_mps);
+  WriteTriple(os, euler_deg);
+  os << '\n';
+}
+
+void KfginsNavWriter::Commit() { file_.Commit(); }
+
+}  // namespace navtwin

@@ -1,0 +1,200 @@
+#include "core/io/text_reader.h"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include "core/io/input_error.h"
+
+namespace navtwin {
+namespace {
+
+bool IsBlankChar(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::string Quote(std::string_view text) {
+  constexpr std::size_t kMaxShown = 40;  // a runaway field should not flood the message
+  std::string s(text.substr(0, kMaxShown));
+  if (text.size() > kMaxShown) s += "...";
+  return "'" + s + "'";
+}
+
+std::string FormatSeconds(double t_s) {
+  std::ostringstream os;
+  os.precision(15);
+  os << t_s << " s";
+  return os.str();
+}
+
+char LowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
+
+}  // namespace
+
+LineReader::LineReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+  if (!in_) throw InputError(path, 0, "", "cannot open the file");
+}
+
+bool LineReader::Next(std::string* line) {
+  line->clear();
+  std::streambuf* buf = in_.rdbuf();
+  line_end_ = LineEnd::kNone;
+  bool any = false;
+  for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+    any = true;
+    ++offset_;
+    if (c == '\n') {
+      line_end_ = LineEnd::kLf;
+      break;
+    }
+    if (c == '\r') {
+      line_end_ = LineEnd::kCr;
+      if (buf->sgetc() == '\n') {
+        buf->sbumpc();
+        ++offset_;
+        line_end_ = LineEnd::kCrLf;
+      }
+      break;
+    }
+    line->push_back(static_cast<char>(c));
+  }
+  if (!any) return false;
+  ++line_number_;
+  return true;
+}
+
+bool IsBlank(std::string_view line) {
+  for (char c : line) {
+    if (!IsBlankChar(c)) return false;
+  }
+  return true;
+}
+
+std::string_view Trim(std::string_view text) {
+  std::size_t b = 0;
+  std::size_t e = text.size();
+  while (b < e && IsBlankChar(text[b])) ++b;
+  while (e > b && IsBlankChar(text[e - 1])) --e;
+  return text.substr(b, e - b);
+}
+
+std::string_view StripUnit(std::string_view name) { return Trim(name.substr(0, name.find('('))); }
+
+void SplitCsv(std::string_view line, std::vector<std::string_view>* fields) {
+  fields->clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      fields->push_back(Trim(line.substr(start)));
+      return;
+    }
+    fields->push_back(Trim(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
+void SplitLoose(std::string_view line, std::vector<std::string_view>* fields) {
+  fields->clear();
+  std::size_t i = 0;
+  const std::size_t n = line.size();
+  while (i < n) {
+    while (i < n && (IsBlankChar(line[i]) || line[i] == ',')) ++i;
+    const std::size_t start = i;
+    while (i < n && !IsBlankChar(line[i]) && line[i] != ',') ++i;
+    if (i > start) fields->push_back(line.substr(start, i - start));
+  }
+}
+
+double ParseDouble(std::string_view text, const std::string& path, long line,
+                   const std::string& field) {
+  std::string_view t = text;
+  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+  if (t.empty() || ec == std::errc::invalid_argument || end != t.data() + t.size()) {
+    throw InputError(path, line, field, "not a number: " + Quote(text));
+  }
+  if (ec == std::errc::result_out_of_range || !std::isfinite(value)) {
+    throw InputError(path, line, field, "not a finite number: " + Quote(text));
+  }
+  return value;
+}
+
+long long ParseInteger(std::string_view text, const std::string& path, long line,
+                       const std::string& field) {
+  std::string_view t = text;
+  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
+  long long value = 0;
+  const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), value);
+  if (t.empty() || ec != std::errc() || end != t.data() + t.size()) {
+    throw InputError(path, line, field, "not an integer: " + Quote(text));
+  }
+  return value;
+}
+
+int ParseWholeNumber(std::string_view text, const std::string& path, long line,
+                     const std::string& field) {
+  const double v = ParseDouble(text, path, line, field);
+  constexpr double kLimit = 1e9;  // far beyond any count or flag these files hold
+  if (v != std::floor(v) || std::fabs(v) > kLimit) {
+    throw InputError(path, line, field, "not a whole number: " + Quote(text));
+  }
+  return static_cast<int>(v);
+}
+
+void RequirePositive(double value, const std::string& path, long line, const std::string& field) {
+  if (!(value > 0.0)) {
+    std::ostringstream os;
+    os << "must be > 0, got " << value;
+    throw InputError(path, line, field, os.str());
+  }
+}
+
+void RequireFieldCount(std::size_t found, std::size_t expected, const std::string& path,
+                       long line) {
+  if (found != expected) {
+    throw InputError(
+        path, line, "",
+        "expected " + std::to_string(expected) + " columns, found " + std::to_string(found));
+  }
+}
+
+void IncreasingTime::Check(double t_s, const std::string& path, long line,
+                           const std::string& field) {
+  if (line_ > 0 && !(t_s > t_s_)) {
+    throw InputError(path, line, field,
+                     "time " + FormatSeconds(t_s) + " does not increase (previous " +
+                         FormatSeconds(t_s_) + " at line " + std::to_string(line_) + ")");
+  }
+  t_s_ = t_s;
+  line_ = line;
+}
+
+bool EqualsNoCase(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (LowerAscii(a[i]) != LowerAscii(b[i])) return false;
+  }
+  return true;
+}
+
+HeaderColumns::HeaderColumns(const std::vector<std::string_view>& names, const std::string& path,
+                             long line)
+    : path_(path), line_(line) {
+  names_.reserve(names.size());
+  for (std::string_view n : names) names_.emplace_back(Trim(n));
+}
+
+int HeaderColumns::Find(std::string_view name) const {
+  for (std::size_t i = 0; i < names_.size(); ++i) {
+    if (EqualsNoCase(names_[i], name)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+int HeaderColumns::Require(const std::string& name) const {
+  const int i = Find(name);
+  if (i < 0) throw InputError(path_, line_, name, "missing column '" + name + "'");
+  return i;
+}
+
+}  // namespace navtwin

@@ -1,0 +1,97 @@
+// Problem-agnostic driver for batch (nonlinear least-squares) problems: Ceres solver
+// options, one progress line per iteration, and covariance extraction in the tangent
+// space of each parameter block's manifold (for an attitude with AttitudeManifold, the
+// covariance of the attitude error phi_n in rad^2, see docs/attitude-error.md).
+//
+// The covariance is the inverse of J^T J at the current parameter values, which is the
+// estimator covariance only if every residual is whitened (unit covariance).
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <ceres/problem.h>
+#include <Eigen/Core>
+
+namespace navtwin {
+
+struct BatchOptions {
+  enum class LinearSolver {
+    kAuto,                   ///< kDenseQr up to dense_max_tangent_size parameters, else sparse
+    kSparseNormalCholesky,   ///< SuiteSparse (Eigen's sparse Cholesky if Ceres lacks SuiteSparse)
+    kDenseQr,
+  };
+  int max_iterations = 100;
+  int num_threads = 1;
+  double function_tolerance = 1e-10;   ///< |cost change| / cost
+  double gradient_tolerance = 1e-12;   ///< max-norm of the projected gradient
+  double parameter_tolerance = 1e-10;  ///< |step| / (|x| + parameter_tolerance)
+  LinearSolver linear_solver = LinearSolver::kAuto;
+  int dense_max_tangent_size = 100;    ///< kAuto threshold on the sum of tangent sizes
+  bool progress = true;                ///< print one line per iteration to the given stream
+};
+
+struct BatchReport {
+  bool converged = false;   ///< Ceres stopped on a convergence criterion
+  int iterations = 0;       ///< iterations after iteration 0 (the start): progress lines - 1
+  double initial_cost = 0.0;
+  double final_cost = 0.0;  ///< Ceres cost, 1/2 sum of squared (whitened) residuals
+  double run_time_s = 0.0;
+  std::string brief_report; ///< ceres::Solver::Summary::BriefReport()
+};
+
+/// Solves the problem in place. Progress (when options.progress and progress != nullptr):
+/// one line per iteration, iteration 0 included:
+///   "batch iter <k> cost <c> cost_change <dc> |gradient| <g> elapsed_s <t>"
+/// Throws std::invalid_argument when the options are not valid for Ceres.
+BatchReport SolveBatch(ceres::Problem& problem, const BatchOptions& options, std::ostream* progress);
+
+struct CovarianceOptions {
+  enum class Algorithm {
+    kAuto,      ///< kDenseSvd up to dense_max_tangent_size free tangent parameters, else kSparseQr
+    kSparseQr,  ///< scales to large problems; fails when QR finds J rank deficient (a numeric
+                ///< rank test: a column that is tiny but not negligible next to the others passes)
+    kDenseSvd,  ///< fails when sigma_min / sigma_max of J < sqrt(min_reciprocal_condition_number)
+  };
+  Algorithm algorithm = Algorithm::kAuto;
+  int dense_max_tangent_size = 200;
+  double min_reciprocal_condition_number = 1e-14;  ///< on eigenvalues of J^T J
+  int num_threads = 1;
+  /// After a failure the null space of J^T J is found by a dense eigen-decomposition,
+  /// only when the free tangent parameters number at most this (O(n^3) time, O(n^2) memory).
+  int max_diagnosis_tangent_size = 1000;
+};
+
+struct CovarianceResult {
+  /// Joint tangent-space covariance of the requested blocks, in their order (each block
+  /// contributes its tangent size); empty when the blocks are not all observable.
+  std::optional<Eigen::MatrixXd> covariance;
+  /// On failure: what failed and which blocks are unobservable; empty on success.
+  std::string message;
+  /// Indices (into the requested blocks) of the blocks with a component in the null space.
+  std::vector<int> unobservable_blocks;
+  /// Null-space directions of J^T J (columns, unit length over all free parameters),
+  /// restricted to the rows of the requested blocks' tangent coordinates.
+  Eigen::MatrixXd null_space;
+};
+
+/// Tangent-space covariance of several blocks (joint, with cross terms). A constant block
+/// has zero covariance. Fails (no covariance; message, unobservable_blocks, null_space
+/// filled) when Ceres finds J rank deficient, or when a requested coordinate's variance
+/// inflation H_ii * P_ii (H = J^T J, unit free, >= 1) exceeds 1 / min_reciprocal_condition_number,
+/// which catches nearly collinear columns that sparse QR's rank test lets through (not a
+/// column that is merely tiny next to the others: dense SVD, kAuto's choice for small
+/// problems, catches that one).
+/// Throws std::invalid_argument for no block, a block not in the problem, or one requested twice.
+CovarianceResult ComputeTangentCovariance(ceres::Problem& problem, const std::vector<const double*>& blocks,
+                                          const CovarianceOptions& options = CovarianceOptions());
+
+/// The covariance of one block in its tangent space; std::nullopt when it is not observable.
+std::optional<Eigen::MatrixXd> TangentCovariance(ceres::Problem& problem, const double* block);
+
+/// Joint tangent covariance of several blocks; std::nullopt when any is not observable.
+std::optional<Eigen::MatrixXd> TangentCovariance(ceres::Problem& problem, const std::vector<const double*>& blocks);
+
+}  // namespace navtwin

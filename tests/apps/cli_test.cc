@@ -1,0 +1,160 @@
+// End-to-end checks of the navtwin command: exit codes, messages that name file and
+// line, no partial output, the demo's error table, and the acceptance facts of `info`.
+#include <dirent.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "tests/test_data.h"
+
+namespace navtwin {
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::string TempDir() {
+  std::string tmpl = ::testing::TempDir() + "navtwin_cli_XXXXXX";
+  char* dir = ::mkdtemp(tmpl.data());
+  EXPECT_NE(dir, nullptr);
+  return tmpl;
+}
+
+RunResult Navtwin(const std::string& args) {
+  static const std::string dir = TempDir();
+  const std::string out = dir + "/stdout", err = dir + "/stderr";
+  const std::string cmd = std::string(NAVTWIN_BIN_DIR) + "/navtwin " + args + " >" + out + " 2>" + err;
+  const int status = std::system(cmd.c_str());
+  RunResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadAll(out);
+  r.err = ReadAll(err);
+  return r;
+}
+
+bool Exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+// The number after "key": in a flat piece of JSON (enough for these fixed outputs).
+double JsonNumberAfter(const std::string& json, const std::string& anchor, const std::string& key) {
+  const std::size_t at = json.find(anchor);
+  if (at == std::string::npos) return NAN;
+  std::smatch m;
+  const std::string rest = json.substr(at);
+  if (!std::regex_search(rest, m, std::regex("\"" + key + "\":(-?[0-9.eE+-]+)"))) return NAN;
+  return std::stod(m[1]);
+}
+
+TEST(Cli, HelpListsSubcommandsAndFlags) {
+  const RunResult main_help = Navtwin("--help");
+  EXPECT_EQ(main_help.exit_code, 0);
+  for (const char* sub : {"info", "convert", "ins"}) {
+    EXPECT_NE(main_help.out.find(sub), std::string::npos) << sub;
+  }
+  const RunResult ins_help = Navtwin("ins --help");
+  EXPECT_EQ(ins_help.exit_code, 0);
+  EXPECT_NE(ins_help.out.find("--init_lat_deg"), std::string::npos);
+  EXPECT_NE(ins_help.out.find("--format"), std::string::npos);
+}
+
+TEST(Cli, MisuseExitsWithUsageCode) {
+  EXPECT_EQ(Navtwin("").exit_code, 2);
+  EXPECT_EQ(Navtwin("no-such-subcommand").exit_code, 2);
+  const RunResult no_out = Navtwin("ins --imu x.txt --init_from y.nav");
+  EXPECT_EQ(no_out.exit_code, 2);
+  EXPECT_NE(no_out.err.find("--out"), std::string::npos);
+  // A flag of another subcommand is refused rather than silently ignored.
+  const RunResult foreign = Navtwin("info --init_lat_deg 3 x.txt");
+  EXPECT_EQ(foreign.exit_code, 2);
+  EXPECT_NE(foreign.err.find("init_lat_deg"), std::string::npos);
+}
+
+TEST(Cli, InfoNamesTheLineWhereTimeGoesBackwards) {
+  const std::string path = TempDir() + "/imu.txt";
+  {
+    std::ofstream f(path);
+    f.precision(12);
+    for (int line = 1; line <= 2000; ++line) {
+      const double t = line == 1234 ? 1000.0 : 1000.0 + 0.005 * line;  // line 1234 goes back
+      f << t << " 1e-5 -2e-5 3e-5 0.001 -0.002 -0.049\n";
+    }
+  }
+  const RunResult r = Navtwin("info " + path);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find(path), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("line 1234"), std::string::npos) << r.err;
+}
+
+TEST(Cli, DemoNavigatesWithSmallErrorsAndWritesTheSolution) {
+  const std::string dir = TempDir();
+  const RunResult r = Navtwin("ins --demo --demo_duration_s 60 --out " + dir + " --format=json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Exact increments: errors at the mm / micro-degree level (see the strapdown tests);
+  // 1 cm and 1e-4 deg leave room for the 17-digit text round trip.
+  EXPECT_LT(JsonNumberAfter(r.out, "\"horizontal_m\"", "max"), 0.01) << r.out;
+  EXPECT_LT(JsonNumberAfter(r.out, "\"yaw_deg\"", "max"), 1e-4) << r.out;
+  EXPECT_EQ(JsonNumberAfter(r.out, "{", "imu_samples"), 6000) << r.out;
+  EXPECT_TRUE(Exists(dir + "/nav.nav"));
+  // The text table has the same rows.
+  const RunResult text = Navtwin("ins --imu " + dir + "/imu.txt --init_from " + dir +
+                                 "/truth.nav --truth " + dir + "/truth.nav --out " + dir + "/again");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("pos N [m]"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("yaw [deg]"), std::string::npos) << text.out;
+}
+
+TEST(Cli, BadInputLeavesNoPartialOutput) {
+  const std::string dir = TempDir();
+  const std::string imu = dir + "/imu.txt", nav = dir + "/init.nav";
+  {
+    std::ofstream f(imu);
+    f << "0.005 0 0 0 0 0 -0.049\n0.010 0 0 0 0 0 -0.049\n0.015 0 nan 0 0 0 -0.049\n";
+    std::ofstream g(nav);
+    g << "0 0.0 45.0 7.0 100.0 0 0 0 0 0 0\n";
+  }
+  const RunResult r = Navtwin("ins --imu " + imu + " --init_from " + nav + " --out " + dir + "/out");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("line 3"), std::string::npos) << r.err;
+  EXPECT_FALSE(Exists(dir + "/out/nav.nav"));
+  // No temporary file left behind either: the output folder is empty.
+  DIR* d = ::opendir((dir + "/out").c_str());
+  ASSERT_NE(d, nullptr);
+  int entries = 0;
+  while (const dirent* e = ::readdir(d)) entries += e->d_name[0] != '.';
+  ::closedir(d);
+  EXPECT_EQ(entries, 0);
+}
+
+TEST(Cli, InfoOnRealUlogShowsImuAndGpsRates) {
+  const std::string path = testing::DataPath("px4-ulog/ekf_failure.ulg");
+  NAVTWIN_REQUIRE_DATA(path);
+  const RunResult r = Navtwin("info " + path + " --format=json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The facts: sensor_combined near 199 Hz, vehicle_gps_position at 5 Hz.
+  EXPECT_NEAR(JsonNumberAfter(r.out, "\"name\":\"sensor_combined\"", "rate_hz"), 199.0, 2.0) << r.out;
+  EXPECT_NEAR(JsonNumberAfter(r.out, "\"name\":\"vehicle_gps_position\"", "rate_hz"), 5.0, 0.2) << r.out;
+}
+
+}  // namespace
+}  // namespace navtwin

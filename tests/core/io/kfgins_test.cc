@@ -1,0 +1,249 @@
+// KF-GINS text formats: writer -> reader round trips and every class of bad input.
+#include "core/io/kfgins.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/io/input_error.h"
+#include "core/rotation.h"
+
+namespace navtwin {
+namespace {
+
+std::string TempPath(const std::string& name) {
+  return ::testing::TempDir() + "navtwin_kfgins_" + name;
+}
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = TempPath(name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+template <typename F>
+void ExpectInputError(F f, std::initializer_list<std::string> parts) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    for (const std::string& p : parts) {
+      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
+    }
+    return;
+  }
+  ADD_FAILURE() << "no InputError";
+}
+
+template <typename Reader, typename Sample>
+std::vector<Sample> ReadAll(Reader reader) {
+  std::vector<Sample> out;
+  Sample s;
+  while (reader->Next(&s)) out.push_back(s);
+  return out;
+}
+
+std::vector<ImuSample> ReadImu(const std::string& path) {
+  return ReadAll<std::unique_ptr<ImuReader>, ImuSample>(OpenKfginsImu(path));
+}
+std::vector<GnssSample> ReadGnss(const std::string& path) {
+  return ReadAll<std::unique_ptr<GnssReader>, GnssSample>(OpenKfginsGnss(path));
+}
+std::vector<NavState> ReadNav(const std::string& path) {
+  return ReadAll<std::unique_ptr<NavReader>, NavState>(OpenKfginsNav(path));
+}
+
+/// IMU samples at ~200 Hz with jittered time tags, dt consistent with the tags (the first
+/// dt equal to the second interval, as the reader reconstructs it).
+std::vector<ImuSample> RandomImu(int n) {
+  std::mt19937 rng(1234);
+  std::normal_distribution<double> inc(0.0, 1e-3);
+  std::uniform_real_distribution<double> step(0.0049, 0.0051);
+  std::vector<ImuSample> v(n);
+  double t = 388000.0;
+  for (int k = 0; k < n; ++k) {
+    v[k].t_s = t;
+    v[k].dtheta_b_rad = Eigen::Vector3d(inc(rng), inc(rng), inc(rng));
+    v[k].dv_b_mps = Eigen::Vector3d(inc(rng), inc(rng), inc(rng) - 0.049);
+    t += step(rng);
+  }
+  for (int k = 1; k < n; ++k) v[k].dt_s = v[k].t_s - v[k - 1].t_s;
+  v[0].dt_s = v[1].dt_s;
+  return v;
+}
+
+TEST(KfginsTest, ImuRoundTripIsExact) {
+  const std::vector<ImuSample> in = RandomImu(500);
+  const std::string path = TempPath("imu_roundtrip.txt");
+  KfginsImuWriter w(path);
+  for (const ImuSample& s : in) w.Write(s);
+  w.Commit();
+  const std::vector<ImuSample> out = ReadImu(path);
+  ASSERT_EQ(out.size(), in.size());
+  // 17 significant digits round-trip a double exactly, so everything compares equal.
+  for (std::size_t k = 0; k < in.size(); ++k) {
+    EXPECT_EQ(out[k].t_s, in[k].t_s);
+    EXPECT_EQ(out[k].dt_s, in[k].dt_s);
+    EXPECT_EQ(out[k].dtheta_b_rad, in[k].dtheta_b_rad);
+    EXPECT_EQ(out[k].dv_b_mps, in[k].dv_b_mps);
+  }
+}
+
+TEST(KfginsTest, ReadsKfginsStyleWhitespaceAndCommas) {
+  const std::string path = WriteTemp("imu_styles.txt",
+                                     "  100.000  1e-4 2e-4 3e-4   0.01 0.02 -0.049\n"
+                                     "\n"
+                                     "100.005,1e-4,2e-4,3e-4,0.01,0.02,-0.049\r\n"
+                                     "# a comment line\n"
+                                     "100.011\t1e-4\t2e-4\t3e-4\t0.01\t0.02\t-0.049\n");
+  const std::vector<ImuSample> out = ReadImu(path);
+  ASSERT_EQ(out.size(), 3u);
+  // Differences of decimal time tags: exact to 1e-9 s (values near 100 s).
+  EXPECT_NEAR(out[0].dt_s, 0.005, 1e-9);
+  EXPECT_NEAR(out[1].dt_s, 0.005, 1e-9);
+  EXPECT_NEAR(out[2].dt_s, 0.006, 1e-9);
+  EXPECT_EQ(out[2].dv_b_mps.z(), -0.049);
+}
+
+TEST(KfginsTest, GnssRoundTripWithAndWithoutVelocity) {
+  for (bool velocity : {false, true}) {
+    std::vector<GnssSample> in(20);
+    for (int k = 0; k < 20; ++k) {
+      GnssSample& g = in[k];
+      g.t_s = 388000.0 + k;
+      g.lat_rad = 0.5372 + 1e-6 * k;
+      g.lon_rad = 1.9942 - 2e-6 * k;
+      g.h_m = 23.4567 + 0.1 * k;
+      g.pos_std_ned_m = Eigen::Vector3d(0.01, 0.012, 0.03);
+      g.has_velocity = velocity;
+      g.v_n_mps = Eigen::Vector3d(1.5, -0.25, 0.01 * k);
+      g.vel_std_ned_mps = Eigen::Vector3d(0.05, 0.05, 0.08);
+    }
+    const std::string path = TempPath(velocity ? "gnss13.txt" : "gnss7.txt");
+    KfginsGnssWriter w(path);
+    for (const GnssSample& g : in) w.Write(g);
+    w.Commit();
+    const std::vector<GnssSample> out = ReadGnss(path);
+    ASSERT_EQ(out.size(), in.size());
+    for (std::size_t k = 0; k < in.size(); ++k) {
+      EXPECT_EQ(out[k].t_s, in[k].t_s);
+      EXPECT_EQ(out[k].gps_week, -1);  // KF-GINS GNSS files do not say the week
+      // rad -> deg (printed exactly) -> rad: two roundings, a few 1e-16 rad (1e-9 m).
+      EXPECT_NEAR(out[k].lat_rad, in[k].lat_rad, 1e-15);
+      EXPECT_NEAR(out[k].lon_rad, in[k].lon_rad, 1e-15);
+      EXPECT_EQ(out[k].h_m, in[k].h_m);
+      EXPECT_EQ(out[k].pos_std_ned_m, in[k].pos_std_ned_m);
+      EXPECT_EQ(out[k].has_velocity, velocity);
+      if (velocity) {
+        EXPECT_EQ(out[k].v_n_mps, in[k].v_n_mps);
+        EXPECT_EQ(out[k].vel_std_ned_mps, in[k].vel_std_ned_mps);
+      }
+    }
+  }
+}
+
+TEST(KfginsTest, NavRoundTripAndUnknownWeekWrittenAsZero) {
+  std::vector<NavState> in(10);
+  for (int k = 0; k < 10; ++k) {
+    NavState& s = in[k];
+    s.gps_week = k < 5 ? -1 : 2381;
+    s.t_s = 408000.0 + 0.1 * k;
+    s.lat_rad = 0.6998 + 1e-7 * k;
+    s.lon_rad = -1.8352;
+    s.h_m = 1601.4;
+    s.v_n_mps = Eigen::Vector3d(0.5, -1.0, 0.02);
+    s.q_n_b = QuatFromEuler(0.01 * k, -0.2, 2.5 - 0.3 * k);
+  }
+  const std::string path = TempPath("nav.txt");
+  KfginsNavWriter w(path);
+  for (const NavState& s : in) w.Write(s);
+  w.Commit();
+  const std::vector<NavState> out = ReadNav(path);
+  ASSERT_EQ(out.size(), in.size());
+  for (std::size_t k = 0; k < in.size(); ++k) {
+    EXPECT_EQ(out[k].gps_week, k < 5 ? 0 : 2381);
+    EXPECT_EQ(out[k].t_s, in[k].t_s);
+    EXPECT_NEAR(out[k].lat_rad, in[k].lat_rad, 1e-15);  // deg <-> rad roundings
+    EXPECT_EQ(out[k].h_m, in[k].h_m);
+    EXPECT_EQ(out[k].v_n_mps, in[k].v_n_mps);
+    // Euler angles printed exactly; quaternion -> Euler -> quaternion: ~1e-15 rad.
+    EXPECT_LT(AttitudeError(out[k].q_n_b, in[k].q_n_b).norm(), 1e-12);
+  }
+}
+
+TEST(KfginsTest, WritersRefuseValuesTheReadersWouldReject) {
+  KfginsGnssWriter w(TempPath("refused.txt"));
+  GnssSample g;  // sigma NaN by default
+  EXPECT_THROW(w.Write(g), std::invalid_argument);
+  KfginsImuWriter wi(TempPath("refused_imu.txt"));
+  ImuSample s;
+  s.dv_b_mps.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(wi.Write(s), std::invalid_argument);
+}
+
+TEST(KfginsTest, UncommittedWriterLeavesNoFile) {
+  const std::string path = TempPath("uncommitted.txt");
+  std::remove(path.c_str());
+  {
+    KfginsImuWriter w(path);
+    w.Write(RandomImu(2)[0]);
+  }
+  EXPECT_FALSE(std::ifstream(path).good());
+}
+
+// Acceptance test: time going backwards at line 1234 is reported at line 1234.
+TEST(KfginsTest, TimeBackwardsAtLine1234IsReportedThere) {
+  std::ostringstream text;
+  for (int line = 1; line <= 1300; ++line) {
+    const double t = line == 1234 ? 100.0 + 0.005 * 1232 : 100.0 + 0.005 * line;
+    text.precision(17);
+    text << t << " 0 0 0 0 0 -0.049\n";
+  }
+  const std::string path = WriteTemp("backwards.txt", text.str());
+  ExpectInputError([&] { ReadImu(path); }, {path, "line 1234", "field 't'", "does not increase"});
+}
+
+TEST(KfginsTest, BadInputMessagesNameFileLineAndField) {
+  const std::string good = "100.000 0 0 0 0 0 -0.049\n";
+  const std::string malformed = WriteTemp("malformed.txt", good + "100.005 0 0 0 0 0\n");
+  ExpectInputError([&] { ReadImu(malformed); },
+                   {malformed, "line 2", "expected 7 columns, found 6"});
+  const std::string nan = WriteTemp("nan.txt", good + "100.005 0 0 0 0 nan -0.049\n");
+  ExpectInputError([&] { ReadImu(nan); }, {"line 2", "field 'dv_y'", "not a finite number"});
+  const std::string text = WriteTemp("text.txt", good + "100.005 0 0 abc 0 0 -0.049\n");
+  ExpectInputError([&] { ReadImu(text); }, {"line 2", "field 'dtheta_z'", "not a number: 'abc'"});
+  const std::string empty = WriteTemp("empty.txt", "");
+  ExpectInputError([&] { ReadImu(empty); }, {empty, "empty"});
+  const std::string blank = WriteTemp("blank.txt", "\n  \n");
+  ExpectInputError([&] { ReadGnss(blank); }, {blank, "empty"});
+  const std::string single = WriteTemp("single.txt", good);
+  ExpectInputError([&] { ReadImu(single); }, {"line 1", "at least two lines"});
+}
+
+TEST(KfginsTest, GnssValidation) {
+  const std::string zero_sigma =
+      WriteTemp("zero_sigma.txt", "1 30.5 114.2 20 0.01 0.01 0.02\n2 30.5 114.2 20 0.01 0 0.02\n");
+  ExpectInputError([&] { ReadGnss(zero_sigma); }, {"line 2", "field 'sigma_e'", "must be > 0"});
+  const std::string mixed =
+      WriteTemp("mixed.txt",
+                "1 30.5 114.2 20 0.01 0.01 0.02\n2 30.5 114.2 20 0.01 0.01 0.02 1 2 3 .1 .1 .1\n");
+  ExpectInputError([&] { ReadGnss(mixed); }, {"line 2", "expected 7 columns, found 13"});
+  const std::string lat = WriteTemp("lat.txt", "1 91 114.2 20 0.01 0.01 0.02\n");
+  ExpectInputError([&] { ReadGnss(lat); }, {"line 1", "field 'lat'"});
+  const std::string count = WriteTemp("count.txt", "1 30.5 114.2 20 0.01 0.01\n");
+  ExpectInputError([&] { ReadGnss(count); }, {"line 1", "expected 7 or 13 columns, found 6"});
+}
+
+TEST(KfginsTest, NavValidation) {
+  const std::string back =
+      WriteTemp("nav_back.txt", "2381 10 30 114 20 0 0 0 0 0 0\n2381 9 30 114 20 0 0 0 0 0 0\n");
+  ExpectInputError([&] { ReadNav(back); }, {"line 2", "field 'sow'", "does not increase"});
+  const std::string week = WriteTemp("nav_week.txt", "2381.5 10 30 114 20 0 0 0 0 0 0\n");
+  ExpectInputError([&] { ReadNav(week); }, {"line 1", "field 'week'"});
+}
+
+}  // namespace
+}  // namespace navtwin

@@ -1,0 +1,186 @@
+// Format detection, dispatch by kind (including ULog) and file summaries.
+#include "core/io/open.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "core/io/input_error.h"
+#include "tests/test_data.h"
+
+namespace navtwin {
+namespace {
+
+std::string MakeTempDir() {
+  std::string pattern = ::testing::TempDir() + "navtwin_open_XXXXXX";
+  if (mkdtemp(pattern.data()) == nullptr) ADD_FAILURE() << "mkdtemp failed";
+  return pattern;
+}
+
+std::string Write(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+template <typename F>
+void ExpectInputError(F f, std::initializer_list<std::string> parts) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    for (const std::string& p : parts) {
+      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
+    }
+    return;
+  }
+  ADD_FAILURE() << "no InputError";
+}
+
+TEST(OpenTest, DetectsEveryTextKindFromItsFirstLines) {
+  const std::string d = MakeTempDir();
+  struct Case {
+    const char* name;
+    const char* text;
+    FileFormat format;
+  };
+  const Case cases[] = {
+      {"imu.txt", "388000.005 1e-5 -2e-5 3e-6 0.001 0.002 -0.049\n", FileFormat::kKfginsImu},
+      {"gnss.txt", "388000 30.5 114.3 20.1 0.01 0.01 0.02\n", FileFormat::kKfginsGnss},
+      {"gnss13.txt", "388000 30.5 114.3 20.1 0.01 0.01 0.02 1 2 3 .1 .1 .1\n",
+       FileFormat::kKfginsGnss},
+      {"nav.txt", "2381 388000 30.5 114.3 20.1 0 0 0 1 2 3\n", FileFormat::kKfginsNav},
+      {"sf.csv", "1756402240.9610000,-0.017,-0.007,1.01,0.0006,-0.0028,0.0027,0,0,0,0\n",
+       FileFormat::kRtklibWalkImuSf},
+      {"sol.pos", "% program : RTKLIB\n", FileFormat::kRtklibPos},
+      {"imu.csv", "# note\nt_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n",
+       FileFormat::kCsvImu},
+      {"rates.csv", "t_ms,gyro_x_dps,gyro_y_dps,gyro_z_dps,acc_x_g,acc_y_g,acc_z_g\n",
+       FileFormat::kCsvImu},
+      {"IMU_1.csv", "time,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z\n",
+       FileFormat::kAnsflImu},
+      {"dot.csv", "SampleTimeFine,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z,\n",
+       FileFormat::kAnsflDotRaw},
+      {"GT.csv",
+       "time,distance(meters),speed(m/s), compass_heading(degrees), pitch(degrees), "
+       "roll(degrees),height_above_takeoff(meters),North,East,Down\n",
+       FileFormat::kAnsflGt},
+      {"GTExtended.csv",
+       "time(millisecond),latitude,longitude,altitude_above_seaLevel(meters),North,East,Down, "
+       "xSpeed(m/s), ySpeed(m/s), zSpeed(m/s), roll(degrees), pitch(degrees), "
+       "compass_heading(degrees)\n",
+       FileFormat::kAnsflGtExtended},
+      {"five.txt", "1 2 3 4 5\n", FileFormat::kUnknown},
+      {"other.csv", "a,b,c\n", FileFormat::kUnknown},
+  };
+  for (const Case& c : cases) {
+    EXPECT_EQ(DetectFormat(Write(d, c.name, c.text)), c.format) << c.name;
+  }
+  const std::string raw = Write(d, "imu_walk.csv", "0.01,-0.02,1.0,0.5,-0.25,9.0,1000\n");
+  Write(d, "imu_walk.csv.tag", "TIMETAG RTKLIB");
+  EXPECT_EQ(DetectFormat(raw), FileFormat::kRtklibWalkImu);
+  EXPECT_EQ(DetectFormat(Write(d, "log.ulg", "not really")), FileFormat::kULog);
+}
+
+TEST(OpenTest, FormatNamesAreDistinct) {
+  std::set<std::string> names;
+  for (int f = 0; f <= static_cast<int>(FileFormat::kUnknown); ++f) {
+    names.insert(FormatName(static_cast<FileFormat>(f)));
+  }
+  EXPECT_EQ(names.size(), static_cast<std::size_t>(FileFormat::kUnknown) + 1);
+  EXPECT_EQ(FormatName(FileFormat::kRtklibPos), "rtklib-pos");
+}
+
+TEST(OpenTest, RefusesStreamsAKindDoesNotHold) {
+  const std::string d = MakeTempDir();
+  const std::string imu = Write(d, "imu.txt", "1.000 0 0 0 0 0 -0.049\n1.005 0 0 0 0 0 -0.049\n");
+  ImuSample s;
+  EXPECT_TRUE(OpenImu(imu)->Next(&s));
+  ExpectInputError([&] { OpenGnss(imu); },
+                   {imu, "cannot read GNSS samples from a file of kind kfgins-imu"});
+  ExpectInputError([&] { OpenNav(imu); }, {"cannot read navigation states"});
+  ExpectInputError([&] { OpenMag(imu); }, {"cannot read magnetometer samples"});
+  ExpectInputError([&] { OpenBaro(imu); }, {"cannot read barometer samples"});
+  const std::string unknown = Write(d, "five.txt", "1 2 3 4 5\n");
+  ExpectInputError([&] { OpenImu(unknown); }, {"of kind unknown"});
+  ExpectInputError([&] { DescribeFile(unknown); }, {"not a recognised format"});
+  const std::string empty = Write(d, "empty.txt", "");
+  ExpectInputError([&] { OpenImu(empty); }, {empty, "empty"});
+}
+
+TEST(OpenTest, DescribesATextFile) {
+  const std::string d = MakeTempDir();
+  const std::string imu =
+      Write(d, "imu.csv",
+            "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
+            "1.00,0,0,0,0,0,0\n1.01,0,0,0,0,0,0\n1.02,0,0,0,0,0,0\n1.05,0,0,0,0,0,0\n");
+  const FileSummary f = DescribeFile(imu);
+  EXPECT_EQ(f.kind, "csv-imu");
+  ASSERT_EQ(f.streams.size(), 1u);
+  EXPECT_EQ(f.streams[0].count, 4u);
+  EXPECT_NEAR(f.streams[0].rate_hz, 100.0, 1e-3);  // median of 0.01, 0.01, 0.03 (float dt)
+  EXPECT_EQ(f.streams[0].gaps, 1u);                // 0.03 s > 2 x the median
+  ASSERT_EQ(f.streams[0].fields.size(), 7u);
+  EXPECT_EQ(f.streams[0].fields[4], "dv_x_mps");
+}
+
+TEST(OpenRealDataTest, DetectsAndDescribesTheRealFiles) {
+  const std::string root = testing::DataPath("");
+  NAVTWIN_REQUIRE_DATA(testing::DataPath("rtklib-walk/imu_1730.csv"));
+  NAVTWIN_REQUIRE_DATA(testing::DataPath("ansfl-quadrotor/StraightLine/path_1/GT.csv"));
+  const struct {
+    const char* path;
+    FileFormat format;
+  } cases[] = {
+      {"rtklib-walk/gnss_1730_sf.pos", FileFormat::kRtklibPos},
+      {"rtklib-walk/imu_1730.csv", FileFormat::kRtklibWalkImu},
+      {"rtklib-walk/imu_1730_sf.csv", FileFormat::kRtklibWalkImuSf},
+      {"ansfl-quadrotor/StraightLine/path_1/IMU_1.csv", FileFormat::kAnsflImu},
+      {"ansfl-quadrotor/StraightLine/path_1/GT.csv", FileFormat::kAnsflGt},
+      {"ansfl-quadrotor/StraightLine/path_1/GTExtended.csv", FileFormat::kAnsflGtExtended},
+      {"ansfl-quadrotor/StraightLine/RAW/Xsens_DOT1_D422CD003EBC_20220707_111110.csv",
+       FileFormat::kAnsflDotRaw},
+      {"ansfl-quadrotor/StraightLine/RAW/Jul-7th-2022-11-10AM-Flight-Airdata.csv",
+       FileFormat::kUnknown},
+      {"px4-ulog/sample.ulg", FileFormat::kULog},
+  };
+  for (const auto& c : cases) EXPECT_EQ(DetectFormat(root + c.path), c.format) << c.path;
+  const FileSummary walk = DescribeFile(root + "rtklib-walk/imu_1730.csv");
+  ASSERT_EQ(walk.streams.size(), 1u);
+  EXPECT_EQ(walk.streams[0].count, 20454u);
+  const FileSummary pos = DescribeFile(root + "rtklib-walk/gnss_1730_sf.pos");
+  EXPECT_EQ(pos.streams[0].count, 536u);
+  EXPECT_NEAR(pos.streams[0].rate_hz, 4.0, 1e-3);  // 0.25 s intervals stored as float
+  const FileSummary gt = DescribeFile(root + "ansfl-quadrotor/StraightLine/path_1/GT.csv");
+  EXPECT_EQ(gt.streams[0].count, 239u);
+  NavState n;
+  EXPECT_TRUE(OpenNav(root + "ansfl-quadrotor/StraightLine/path_1/GTExtended.csv")->Next(&n));
+  MagSample m;
+  EXPECT_TRUE(OpenMag(root + "ansfl-quadrotor/StraightLine/RAW/"
+                             "Xsens_DOT1_D422CD003EBC_20220707_111110.csv")
+                  ->Next(&m));
+}
+
+// ULog dispatch goes to core/io/ulog.h (tested in ulog_test.cc); here only that each
+// stream reaches it.
+TEST(OpenRealDataTest, DispatchesULogStreams) {
+  const std::string sample = testing::DataPath("px4-ulog/sample.ulg");
+  const std::string ekf = testing::DataPath("px4-ulog/ekf_failure.ulg");
+  NAVTWIN_REQUIRE_DATA(sample);
+  NAVTWIN_REQUIRE_DATA(ekf);
+  ImuSample imu;
+  EXPECT_TRUE(OpenImu(sample)->Next(&imu));
+  MagSample mag;
+  EXPECT_TRUE(OpenMag(sample)->Next(&mag));
+  GnssSample gnss;
+  EXPECT_TRUE(OpenGnss(ekf)->Next(&gnss));
+  BaroSample baro;
+  EXPECT_TRUE(OpenBaro(ekf)->Next(&baro));
+  ExpectInputError([&] { OpenNav(sample); }, {"cannot read navigation states", "ulog"});
+  EXPECT_EQ(DescribeFile(sample).kind, "ulog");
+}
+
+}  // namespace
+}  // namespace navtwin

@@ -1,0 +1,186 @@
+// RTKLIB .pos solution files: header-driven columns, time systems, refusals, real file.
+#include "core/io/rtklib_pos.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/io/input_error.h"
+#include "core/rotation.h"
+#include "tests/test_data.h"
+
+namespace navtwin {
+namespace {
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "navtwin_pos_" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+template <typename F>
+void ExpectInputError(F f, std::initializer_list<std::string> parts) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    for (const std::string& p : parts) {
+      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
+    }
+    return;
+  }
+  ADD_FAILURE() << "no InputError";
+}
+
+std::vector<GnssSample> ReadAll(const std::string& path) {
+  auto reader = OpenRtklibPos(path);
+  std::vector<GnssSample> out;
+  GnssSample s;
+  while (reader->Next(&s)) out.push_back(s);
+  return out;
+}
+
+const char kHeader[] =
+    "% program   : RTKLIB ver.demo5\n"
+    "%  GPST                  latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
+    "sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio  vn(m/s)   ve(m/s)    vu(m/s)  "
+    "  sdvn      sdve     sdvu       sdvne    sdveu      sdvun\n";
+const char kTail[] =
+    "   1601.4350   1  25   0.0100   0.0200   0.0300   0.0000   0.0000   "
+    "0.0000   0.00    0.0   0.1 0.2 0.3  0.04 0.05 0.06 0 0 0\n";
+
+TEST(RtklibPosTest, CalendarTimeLlhAndVelocity) {
+  const std::string path = WriteTemp(
+      "good.pos", std::string(kHeader) + "2025/08/28 17:30:39.749   40.096691600 -105.147166500" +
+                      kTail + "2025/08/28 17:30:39.999   40.096691600 -105.147166500" + kTail);
+  const std::vector<GnssSample> g = ReadAll(path);
+  ASSERT_EQ(g.size(), 2u);
+  // 2025-08-28 is a Thursday of GPS week 2381: 4 days + 17:30:39.749.
+  EXPECT_EQ(g[0].gps_week, 2381);
+  EXPECT_NEAR(g[0].t_s, 4 * 86400 + 17 * 3600 + 30 * 60 + 39.749, 1e-9);
+  EXPECT_NEAR(g[1].t_s - g[0].t_s, 0.25, 1e-9);
+  EXPECT_NEAR(g[0].lat_rad, 40.0966916 * kDegToRad, 1e-15);
+  EXPECT_NEAR(g[0].lon_rad, -105.1471665 * kDegToRad, 1e-15);
+  EXPECT_EQ(g[0].h_m, 1601.435);
+  EXPECT_EQ(g[0].quality, 1);
+  EXPECT_EQ(g[0].num_sats, 25);
+  EXPECT_EQ(g[0].pos_std_ned_m, Eigen::Vector3d(0.01, 0.02, 0.03));
+  ASSERT_TRUE(g[0].has_velocity);
+  EXPECT_EQ(g[0].v_n_mps, Eigen::Vector3d(0.1, 0.2, -0.3));  // down = -up
+  EXPECT_EQ(g[0].vel_std_ned_mps, Eigen::Vector3d(0.04, 0.05, 0.06));
+}
+
+TEST(RtklibPosTest, WeekTowTimeAndNoVelocityColumns) {
+  const std::string path = WriteTemp(
+      "weektow.pos",
+      "%  GPST          latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   "
+      "sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n"
+      "2381 604799.500 40.1 -105.1 1601.4 5 9 1.5 1.5 3.0 0 0 0 0 0\n"
+      "2382      0.500 40.1 -105.1 1601.4 5 9 1.5 1.5 3.0 0 0 0 0 0\n");
+  const std::vector<GnssSample> g = ReadAll(path);
+  ASSERT_EQ(g.size(), 2u);
+  EXPECT_FALSE(g[0].has_velocity);
+  // Times count from the first epoch's week, so they keep increasing across the week.
+  EXPECT_EQ(g[1].gps_week, 2381);
+  EXPECT_EQ(g[1].t_s, 604800.5);
+  EXPECT_EQ(g[0].quality, 5);
+}
+
+TEST(RtklibPosTest, UtcNeedsTheLeapSecondsFromTheHeader) {
+  const std::string utc_header =
+      "%  UTC                   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
+      "sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n";
+  const std::string line = "2025/08/28 17:30:21.749 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2 0 0 0 0 0\n";
+  const std::string refused = WriteTemp("utc.pos", utc_header + line);
+  ExpectInputError([&] { ReadAll(refused); }, {refused, "line 1", "UTC", "leap seconds"});
+  const std::string with_leap =
+      WriteTemp("utc_leap.pos", "% leap seconds: 18\n" + utc_header + line);
+  const std::vector<GnssSample> g = ReadAll(with_leap);
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_NEAR(g[0].t_s, 4 * 86400 + 17 * 3600 + 30 * 60 + 39.749, 1e-9);  // UTC + 18 s
+}
+
+TEST(RtklibPosTest, RefusesOtherSolutionFormats) {
+  const std::string xyz = WriteTemp(
+      "xyz.pos",
+      "%  GPST                   x-ecef(m)      y-ecef(m)      z-ecef(m)   Q  ns   sdx(m)   "
+      "sdy(m)   sdz(m)\n2025/08/28 17:30:39.749 -1 2 3 1 9 0.1 0.1 0.1\n");
+  ExpectInputError([&] { ReadAll(xyz); }, {"x-ecef", "latitude/longitude/height"});
+  const std::string enu =
+      WriteTemp("enu.pos",
+                "%  GPST   e-baseline(m)  n-baseline(m)  u-baseline(m)   Q  ns   sde(m)   sdn(m)   "
+                "sdu(m)\n2025/08/28 17:30:39.749 1 2 3 1 9 0.1 0.1 0.1\n");
+  ExpectInputError([&] { ReadAll(enu); }, {"baseline", "latitude/longitude/height"});
+  const std::string dms =
+      WriteTemp("dms.pos",
+                "%  GPST   latitude(d'\")  longitude(d'\")  height(m)   Q  ns   sdn(m)   sde(m)   "
+                "sdu(m)\n2025/08/28 17:30:39.749 40 5 48.09 -105 8 49.8 1601 1 9 0.1 0.1 0.1\n");
+  ExpectInputError([&] { ReadAll(dms); }, {"deg-min-sec"});
+  const std::string no_header =
+      WriteTemp("noheader.pos", "2025/08/28 17:30:39.749 40 -105 1601 1 9\n");
+  ExpectInputError([&] { ReadAll(no_header); }, {"column-name header"});
+}
+
+TEST(RtklibPosTest, BadLinesNameLineAndField) {
+  const std::string head =
+      "%  GPST   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)\n";
+  const std::string ok = "2025/08/28 17:30:39.749 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n";
+  const std::string zero = WriteTemp(
+      "zero.pos", head + ok + "2025/08/28 17:30:39.999 40.1 -105.1 1601.4 1 9 0 0.1 0.2\n");
+  ExpectInputError([&] { ReadAll(zero); }, {"line 3", "field 'sdn'", "must be > 0"});
+  const std::string back = WriteTemp(
+      "back.pos", head + ok + "2025/08/28 17:30:39.499 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n");
+  ExpectInputError([&] { ReadAll(back); }, {"line 3", "does not increase"});
+  const std::string shortline =
+      WriteTemp("short.pos", head + ok + "2025/08/28 17:30:39.999 40.1 -105.1 1601.4 1 9 0.1\n");
+  ExpectInputError([&] { ReadAll(shortline); }, {"line 3", "expected 10 columns, found 8"});
+  const std::string nan =
+      WriteTemp("nan.pos", head + "2025/08/28 17:30:39.749 nan -105.1 1601.4 1 9 0.1 0.1 0.2\n");
+  ExpectInputError([&] { ReadAll(nan); }, {"line 2", "field 'latitude'", "not a finite number"});
+  const std::string missing = WriteTemp(
+      "missing.pos",
+      "%  GPST   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)\n" + ok);
+  ExpectInputError([&] { ReadAll(missing); }, {"line 1", "missing column 'sdu'"});
+  const std::string header_only = WriteTemp("header_only.pos", head);
+  ExpectInputError([&] { ReadAll(header_only); }, {header_only, "no solution epochs"});
+  const std::string empty = WriteTemp("empty.pos", "");
+  ExpectInputError([&] { ReadAll(empty); }, {empty, "column-name header"});
+}
+
+TEST(RtklibPosTest, GpsTimeHelpers) {
+  EXPECT_EQ(DaysFromCivil(1970, 1, 1), 0);
+  EXPECT_EQ(DaysFromCivil(1980, 1, 6) * 86400, 315964800);  // the GPS epoch in Unix-like seconds
+  EXPECT_EQ(DaysFromCivil(2000, 3, 1) - DaysFromCivil(2000, 2, 28), 2);  // 2000 was a leap year
+  const GpsWeekTime t = GpsTimeFromGpst1970(1756402240, 0.961);  // the rtklib-walk tag header
+  EXPECT_EQ(t.week, 2381);
+  EXPECT_NEAR(t.sow_s, 408640.961, 1e-9);
+}
+
+TEST(RtklibPosTest, RealWalkSolutionFile) {
+  const std::string path = testing::DataPath("rtklib-walk/gnss_1730_sf.pos");
+  NAVTWIN_REQUIRE_DATA(path);
+  const std::vector<GnssSample> g = ReadAll(path);
+  // 536 epochs at 4 Hz (counted with grep; every interval is 0.25 s), RTK fix or float.
+  ASSERT_EQ(g.size(), 536u);
+  EXPECT_EQ(g.front().gps_week, 2381);
+  EXPECT_NEAR(g.front().t_s, 408639.749, 1e-6);
+  EXPECT_NEAR(g.back().t_s, 408773.499, 1e-6);
+  int fix = 0, flt = 0;
+  for (std::size_t k = 0; k < g.size(); ++k) {
+    EXPECT_TRUE(g[k].has_velocity);
+    EXPECT_GT(g[k].vel_std_ned_mps.minCoeff(), 0.0);
+    fix += g[k].quality == 1;
+    flt += g[k].quality == 2;
+    if (k > 0) {
+      EXPECT_NEAR(g[k].t_s - g[k - 1].t_s, 0.25, 1e-6);  // ms-rounded times
+    }
+  }
+  EXPECT_EQ(fix, 349);
+  EXPECT_EQ(flt, 187);
+  EXPECT_NEAR(g.front().lat_rad * kRadToDeg, 40.0966916, 1e-9);
+}
+
+}  // namespace
+}  // namespace navtwin
