@@ -8,6 +8,25 @@
 #include "core/rotation.h"
 
 namespace navtwin {
+namespace {
+
+// Coefficients of the rotation compensation for a body rotating at constant rate by
+// theta over the interval: integral of Exp(alpha(t)) f dt = dv + A theta x dv +
+// B theta x (theta x dv), A = (1 - cos t)/t^2, B = (1 - sin(t)/t)/t^2. Series below
+// t^2 = 1e-4, where they are exact to double precision.
+double RotationCompensationA(double t_sq) {
+  if (t_sq < 1e-4) return 0.5 - t_sq / 24.0 + t_sq * t_sq / 720.0;
+  const double t = std::sqrt(t_sq);
+  return (1.0 - std::cos(t)) / t_sq;
+}
+
+double RotationCompensationB(double t_sq) {
+  if (t_sq < 1e-4) return 1.0 / 6.0 - t_sq / 120.0 + t_sq * t_sq / 5040.0;
+  const double t = std::sqrt(t_sq);
+  return (1.0 - std::sin(t) / t) / t_sq;
+}
+
+}  // namespace
 
 Strapdown::Strapdown(const NavState& initial, const StrapdownOptions& options)
     : state_(initial), options_(options) {
@@ -42,8 +61,13 @@ void Strapdown::Update(const ImuSample& imu) {
   const Eigen::Vector3d zeta_x = (w_ie_n + w_en_n) * dt;
 
   // 2. Velocity. Specific-force increment in the body frame at t_{k-1}: rotation
-  //    correction and two-sample sculling correction.
-  Eigen::Vector3d dv_sf_b = dv + 0.5 * dtheta.cross(dv);
+  //    compensation to second order in the rotation angle (exact for constant rate and
+  //    specific force over the interval, docs/strapdown.md) and the two-sample sculling
+  //    correction.
+  const double theta_sq = dtheta.squaredNorm();
+  const Eigen::Vector3d theta_x_dv = dtheta.cross(dv);
+  Eigen::Vector3d dv_sf_b = dv + RotationCompensationA(theta_sq) * theta_x_dv +
+                            RotationCompensationB(theta_sq) * dtheta.cross(theta_x_dv);
   if (two_sample) {
     dv_sf_b += (prev_dtheta_b_rad_.cross(dv) + prev_dv_b_mps_.cross(dtheta)) / 12.0;
   }

@@ -2,6 +2,7 @@
 // span, rate, gaps and fields.
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -14,18 +15,24 @@ DECLARE_string(format);
 namespace navtwin::app {
 namespace {
 
+// Text: one line per stream with aligned columns; at most kMaxFields fields are listed
+// (--format=json lists them all).
 void PrintText(const FileSummary& s) {
+  constexpr std::size_t kMaxFields = 12;
+  std::size_t width = 8;
+  for (const StreamSummary& st : s.streams) width = std::max(width, st.name.size());
   std::cout << s.path << ": " << s.kind << "\n";
   for (const StreamSummary& st : s.streams) {
     char line[256];
     std::snprintf(line, sizeof line,
-                  "  %-28s %9zu samples  t %.3f .. %.3f s (%.1f s)  %.2f Hz  %zu gaps (max %.3f s)\n",
-                  st.name.c_str(), st.count, st.t_first_s, st.t_last_s, st.t_last_s - st.t_first_s,
-                  st.rate_hz, st.gaps, st.max_gap_s);
+                  "  %-*s %9zu samples  t %.3f .. %.3f s (%.1f s)  %.2f Hz  %zu gaps (max %.3f s)\n",
+                  static_cast<int>(width), st.name.c_str(), st.count, st.t_first_s, st.t_last_s,
+                  st.t_last_s - st.t_first_s, st.rate_hz, st.gaps, st.max_gap_s);
     std::cout << line;
     if (!st.fields.empty()) {
-      std::cout << "      fields:";
-      for (const std::string& f : st.fields) std::cout << ' ' << f;
+      std::cout << "  " << std::string(width, ' ') << " fields:";
+      for (std::size_t i = 0; i < st.fields.size() && i < kMaxFields; ++i) std::cout << ' ' << st.fields[i];
+      if (st.fields.size() > kMaxFields) std::cout << " ... (" << st.fields.size() - kMaxFields << " more)";
       std::cout << "\n";
     }
   }

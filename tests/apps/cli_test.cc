@@ -110,10 +110,10 @@ TEST(Cli, DemoNavigatesWithSmallErrorsAndWritesTheSolution) {
   const std::string dir = TempDir();
   const RunResult r = Navtwin("ins --demo --demo_duration_s 60 --out " + dir + " --format=json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  // Exact increments: errors at the mm / micro-degree level (see the strapdown tests);
-  // 1 cm and 1e-4 deg leave room for the 17-digit text round trip.
-  EXPECT_LT(JsonNumberAfter(r.out, "\"horizontal_m\"", "max"), 0.01) << r.out;
-  EXPECT_LT(JsonNumberAfter(r.out, "\"yaw_deg\"", "max"), 1e-4) << r.out;
+  // Exact increments through 17-digit text files: micrometres and 1e-10 deg over 60 s
+  // (the strapdown tests); 0.1 mm and 1e-7 deg catch any unit or frame slip.
+  EXPECT_LT(JsonNumberAfter(r.out, "\"horizontal_m\"", "max"), 1e-4) << r.out;
+  EXPECT_LT(JsonNumberAfter(r.out, "\"yaw_deg\"", "max"), 1e-7) << r.out;
   EXPECT_EQ(JsonNumberAfter(r.out, "{", "imu_samples"), 6000) << r.out;
   EXPECT_TRUE(Exists(dir + "/nav.nav"));
   // The text table has the same rows.
