@@ -25,9 +25,9 @@ void PrintText(const FileSummary& s) {
   for (const StreamSummary& st : s.streams) {
     char line[256];
     std::snprintf(line, sizeof line,
-                  "  %-*s %9zu samples  t %.3f .. %.3f s (%.1f s)  %.2f Hz  %zu gaps (max %.3f s)\n",
+                  "  %-*s %9zu samples  t %.3f .. %.3f s (%.1f s)  %.2f Hz (mean %.2f)  %zu gaps (max %.3f s)\n",
                   static_cast<int>(width), st.name.c_str(), st.count, st.t_first_s, st.t_last_s,
-                  st.t_last_s - st.t_first_s, st.rate_hz, st.gaps, st.max_gap_s);
+                  st.t_last_s - st.t_first_s, st.rate_hz, st.mean_rate_hz, st.gaps, st.max_gap_s);
     std::cout << line;
     if (!st.fields.empty()) {
       std::cout << "  " << std::string(width, ' ') << " fields:";
@@ -50,6 +50,7 @@ void PrintJson(const FileSummary& s) {
         .Field("t_first_s", st.t_first_s)
         .Field("t_last_s", st.t_last_s)
         .Field("rate_hz", st.rate_hz)
+        .Field("mean_rate_hz", st.mean_rate_hz)
         .Field("gaps", st.gaps)
         .Field("max_gap_s", st.max_gap_s);
     w.Key("fields").BeginArray();

@@ -27,6 +27,10 @@ double TimeTagStats::rate_hz() const {
   return dt > 0.0 ? 1.0 / dt : 0.0;
 }
 
+double TimeTagStats::mean_rate_hz() const {
+  return span_s() > 0.0 ? static_cast<double>(count_ - 1) / span_s() : 0.0;
+}
+
 std::size_t TimeTagStats::gap_count(double gap_factor) const {
   const double limit = gap_factor * median_dt_s();
   return static_cast<std::size_t>(
@@ -45,6 +49,7 @@ StreamSummary StreamSummary::FromStats(const std::string& name, const TimeTagSta
   s.t_first_s = stats.first_s();
   s.t_last_s = stats.last_s();
   s.rate_hz = stats.rate_hz();
+  s.mean_rate_hz = stats.mean_rate_hz();
   s.gaps = stats.gap_count();
   s.max_gap_s = stats.max_dt_s();
   s.fields = std::move(fields);

@@ -21,6 +21,8 @@ class TimeTagStats {
   double median_dt_s() const;
   /// 1 / median interval (0 with fewer than two samples).
   double rate_hz() const;
+  /// (count - 1) / span (0 with fewer than two samples or a zero span).
+  double mean_rate_hz() const;
   /// Intervals longer than gap_factor times the median.
   std::size_t gap_count(double gap_factor = 2.0) const;
   double max_dt_s() const;
@@ -37,7 +39,8 @@ struct StreamSummary {
   std::size_t count = 0;
   double t_first_s = 0.0;
   double t_last_s = 0.0;
-  double rate_hz = 0.0;             ///< from the median interval
+  double rate_hz = 0.0;             ///< from the median interval (the nominal rate)
+  double mean_rate_hz = 0.0;        ///< (count - 1) / span: lower than rate_hz when samples drop
   std::size_t gaps = 0;             ///< intervals > 2x the median
   double max_gap_s = 0.0;           ///< longest interval
   std::vector<std::string> fields;  ///< columns or message fields, with units where known
