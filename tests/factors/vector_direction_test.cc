@@ -10,33 +10,19 @@
 
 #include "core/rotation.h"
 #include "factors/attitude_manifold.h"
+#include "tests/factors/factor_test_util.h"
 
 namespace navtwin {
 namespace {
 
-using Jacobian34 = Eigen::Matrix<double, 3, 4, Eigen::RowMajor>;
-using Jacobian43 = Eigen::Matrix<double, 4, 3, Eigen::RowMajor>;
-
-Eigen::Vector3d Residual(const ceres::CostFunction& f, const Eigen::Vector4d& q, Jacobian34* jacobian = nullptr) {
-  Eigen::Vector3d r;
-  const double* parameters[] = {q.data()};
-  double* jacobians[] = {jacobian != nullptr ? jacobian->data() : nullptr};
-  EXPECT_TRUE(f.Evaluate(parameters, r.data(), jacobian != nullptr ? jacobians : nullptr));
-  return r;
-}
+using testing::Jacobian34;
+using testing::Jacobian43;
+using testing::NumericJacobian;
+using testing::Residual;
 
 // Central differences, h = 1e-6: truncation ~h^2 |r'''| and rounding ~eps |r| / h, both
 // <= 1e-8 for sigma = 0.05 (|r| and its derivatives are O(1/sigma) = 20), so 1e-6
 // separates them from real errors (Jacobian entries are O(20)).
-Jacobian34 NumericJacobian(const ceres::CostFunction& f, const Eigen::Vector4d& q) {
-  constexpr double kStep = 1e-6;
-  Jacobian34 jacobian;
-  for (int i = 0; i < 4; ++i) {
-    const Eigen::Vector4d h = kStep * Eigen::Vector4d::Unit(i);
-    jacobian.col(i) = (Residual(f, q + h) - Residual(f, q - h)) / (2.0 * kStep);
-  }
-  return jacobian;
-}
 constexpr double kJacobianTol = 1e-6;
 constexpr double kSigma = 0.05;
 

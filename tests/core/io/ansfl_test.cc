@@ -2,7 +2,6 @@
 #include "core/io/ansfl.h"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <cmath>
 #include <fstream>
@@ -10,53 +9,19 @@
 #include <vector>
 
 #include "core/earth.h"
-#include "core/io/input_error.h"
 #include "core/rotation.h"
+#include "tests/core/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace navtwin {
 namespace {
 
+using testing::ExpectInputError;
+using testing::MakeTempDir;
+using testing::ReadAllSamples;
+using testing::WriteFile;
+
 constexpr double kPeriod = 1.0 / 120.0;
-
-std::string MakeTempDir() {
-  std::string pattern = ::testing::TempDir() + "navtwin_ansfl_XXXXXX";
-  if (mkdtemp(pattern.data()) == nullptr) ADD_FAILURE() << "mkdtemp failed";
-  return pattern;
-}
-
-std::string Write(const std::string& dir, const std::string& name, const std::string& text) {
-  const std::string path = dir + "/" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const std::string& p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
-
-template <typename Sample, typename Reader>
-std::vector<Sample> Drain(Reader reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
-
-std::vector<ImuSample> Imu(const std::string& path) { return Drain<ImuSample>(OpenAnsflImu(path)); }
-std::vector<ImuSample> RawImu(const std::string& path) {
-  return Drain<ImuSample>(OpenAnsflDotRawImu(path));
-}
-std::vector<NavState> Gt(const std::string& path) { return Drain<NavState>(OpenAnsflGt(path)); }
 
 std::size_t CountLines(const std::string& path) {
   std::ifstream in(path);
@@ -75,7 +40,8 @@ TEST(AnsflTest, ProcessedDotRatesBecomeIncrementsInSensorAxes) {
   const std::string dir = MakeTempDir();
   std::string text = kDotHeader;
   for (int k = 0; k < 5; ++k) text += DotRow(k * 0.008333);
-  const std::vector<ImuSample> s = Imu(Write(dir, "IMU_1.csv", text));
+  const std::vector<ImuSample> s =
+      ReadAllSamples(*OpenAnsflImu(WriteFile(dir + "/IMU_1.csv", text)));
   ASSERT_EQ(s.size(), 4u);  // the first row starts the series
   // Constant rates: rate * dt exactly up to rounding (1e-15).
   EXPECT_NEAR(s[0].dt_s, 0.008333, 1e-15);
@@ -90,8 +56,8 @@ TEST(AnsflTest, LostSamplePatternIsRetimed) {
   const double P = 0.008333;
   std::string text = kDotHeader;
   for (double t : {0.0, P, 2 * P, 4 * P, 4 * P, 5 * P}) text += DotRow(t);
-  const std::string path = Write(dir, "IMU_2.csv", text);
-  const std::vector<ImuSample> s = Imu(path);
+  const std::string path = WriteFile(dir + "/IMU_2.csv", text);
+  const std::vector<ImuSample> s = ReadAllSamples(*OpenAnsflImu(path));
   ASSERT_EQ(s.size(), 5u);
   for (int k = 0; k < 5; ++k) {
     EXPECT_NEAR(s[k].t_s, (k + 1) * P, 1e-6) << k;  // printed with 6 decimals
@@ -108,20 +74,24 @@ TEST(AnsflTest, RepeatedTimeOutsideThePatternIsAnError) {
   const double P = 0.008333;
   std::string text = kDotHeader;
   for (double t : {0.0, P, 2 * P, 2 * P, 3 * P}) text += DotRow(t);
-  const std::string path = Write(dir, "IMU_3.csv", text);
-  ExpectInputError([&] { Imu(path); }, {path, "line 5", "field 'time'", "repeats line 4"});
+  const std::string path = WriteFile(dir + "/IMU_3.csv", text);
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflImu(path)); },
+                   {path, "line 5", "field 'time'", "repeats line 4"});
   std::string back = kDotHeader;
   for (double t : {0.0, P, 2 * P, P}) back += DotRow(t);
-  const std::string back_path = Write(dir, "IMU_4.csv", back);
-  ExpectInputError([&] { Imu(back_path); }, {"line 5", "does not increase"});
-  const std::string nan = Write(
-      dir, "nan.csv", std::string(kDotHeader) + DotRow(0) + "0.008333,0,0,0,0.1,NaN,9.81,0,0,90\n");
-  ExpectInputError([&] { Imu(nan); }, {"line 3", "field 'Acc_Y'", "not a finite number"});
+  const std::string back_path = WriteFile(dir + "/IMU_4.csv", back);
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflImu(back_path)); },
+                   {"line 5", "does not increase"});
+  const std::string nan = WriteFile(dir + "/nan.csv", std::string(kDotHeader) + DotRow(0) +
+                                                          "0.008333,0,0,0,0.1,NaN,9.81,0,0,90\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflImu(nan)); },
+                   {"line 3", "field 'Acc_Y'", "not a finite number"});
   const std::string missing =
-      Write(dir, "missing.csv", "time,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y\n0,0,0,0,0,0\n");
-  ExpectInputError([&] { Imu(missing); }, {"line 1", "missing column 'Gyr_Z'"});
-  const std::string empty = Write(dir, "empty.csv", "");
-  ExpectInputError([&] { Imu(empty); }, {empty, "empty"});
+      WriteFile(dir + "/missing.csv", "time,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y\n0,0,0,0,0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflImu(missing)); },
+                   {"line 1", "missing column 'Gyr_Z'"});
+  const std::string empty = WriteFile(dir + "/empty.csv", "");
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflImu(empty)); }, {empty, "empty"});
 }
 
 /// A raw DOT row with the trailing comma and blank of the real files.
@@ -143,8 +113,8 @@ TEST(AnsflTest, RawDotUnwrapsTheClockSkipsZeroRowsAndDropsLostRows) {
     text += RawRow(t, data);
     if (k == 5) text += RawRow(t, "NaN,NaN,NaN,Infinity,Infinity,Infinity");  // ...marked so
   }
-  const std::string path = Write(dir, "Xsens_DOT9.csv", text);
-  const std::vector<ImuSample> s = RawImu(path);
+  const std::string path = WriteFile(dir + "/Xsens_DOT9.csv", text);
+  const std::vector<ImuSample> s = ReadAllSamples(*OpenAnsflDotRawImu(path));
   // Rows: zero (skipped), 1, 2, 3, 5 (re-timed to 4), 5 (NaN, dropped), 6: five rate
   // samples -> four increments, at 2..6 periods after the start.
   ASSERT_EQ(s.size(), 4u);
@@ -154,7 +124,7 @@ TEST(AnsflTest, RawDotUnwrapsTheClockSkipsZeroRowsAndDropsLostRows) {
     EXPECT_NEAR(s[k].t_s - t0, expected[k] * 8333e-6, 1e-9) << k;  // us ticks in double
   }
   EXPECT_NEAR(s[3].dtheta_b_rad.z(), 30 * kDegToRad * 2 * 8333e-6, 1e-12);  // bridged gap
-  const std::vector<MagSample> m = Drain<MagSample>(OpenAnsflDotRawMag(path));
+  const std::vector<MagSample> m = ReadAllSamples(*OpenAnsflDotRawMag(path));
   ASSERT_EQ(m.size(), 7u);  // every row has a finite magnetometer
   EXPECT_NEAR(m[0].m_b_uT.x(), -0.5 * kXsensDotMagUtPerUnit, 1e-12);
   const FileSummary d = DescribeAnsflDotRaw(path);
@@ -171,9 +141,10 @@ TEST(AnsflTest, RawDotNanOutsideThePatternIsAnError) {
   const std::string header =
       "SampleTimeFine,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z,\n";
   const std::string text = header + "1000,1,2,3,0,0,9.8,0,0,30, \n9333,1,2,3,0,0,9.8,NaN,0,30, \n";
-  const std::string path = Write(dir, "Xsens_DOT4.csv", text);
-  ExpectInputError([&] { RawImu(path); }, {"line 3", "field 'Gyr_X'", "not a finite number"});
-  ExpectInputError([&] { Drain<MagSample>(OpenAnsflDotRawMag(path)); }, {"missing column 'Mag_X'"});
+  const std::string path = WriteFile(dir + "/Xsens_DOT4.csv", text);
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflDotRawImu(path)); },
+                   {"line 3", "field 'Gyr_X'", "not a finite number"});
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflDotRawMag(path)); }, {"missing column 'Mag_X'"});
 }
 
 std::string GtText(int rows) {
@@ -190,7 +161,8 @@ std::string GtText(int rows) {
 
 TEST(AnsflTest, GtWithoutExtendedUsesZeroOriginAndDifferencedVelocity) {
   const std::string dir = MakeTempDir();
-  const std::vector<NavState> s = Gt(Write(dir, "GT.csv", GtText(5)));
+  const std::vector<NavState> s =
+      ReadAllSamples(*OpenAnsflGt(WriteFile(dir + "/GT.csv", GtText(5))));
   ASSERT_EQ(s.size(), 5u);
   EXPECT_EQ(s[0].gps_week, -1);
   EXPECT_NEAR(s[0].lat_rad, 0.0, 1e-15);
@@ -209,15 +181,15 @@ TEST(AnsflTest, GtWithoutExtendedUsesZeroOriginAndDifferencedVelocity) {
 
 TEST(AnsflTest, GtWithExtendedTakesOriginAndSpeedsAndChecksPairing) {
   const std::string dir = MakeTempDir();
-  Write(dir, "GTExtended.csv",
-        "time(millisecond),latitude,longitude,altitude_above_seaLevel(meters),North,East,Down, "
-        "xSpeed(m/s), ySpeed(m/s), zSpeed(m/s), roll(degrees), pitch(degrees), "
-        "compass_heading(degrees)\n"
-        "56100,32.8,34.9,10.0,0,0,0,2.1,-1.1,-0.4,1,-2,270\n"
-        "56200,32.8,34.9,10.0,0,0,0,2.1,-1.1,-0.4,1,-2,270\n"
-        "56300,32.8,34.9,10.0,0,0,0,2.2,-1.2,-0.6,1,-2,270\n");
-  const std::string gt = Write(dir, "GT.csv", GtText(3));
-  const std::vector<NavState> s = Gt(gt);
+  WriteFile(dir + "/GTExtended.csv",
+            "time(millisecond),latitude,longitude,altitude_above_seaLevel(meters),North,East,Down, "
+            "xSpeed(m/s), ySpeed(m/s), zSpeed(m/s), roll(degrees), pitch(degrees), "
+            "compass_heading(degrees)\n"
+            "56100,32.8,34.9,10.0,0,0,0,2.1,-1.1,-0.4,1,-2,270\n"
+            "56200,32.8,34.9,10.0,0,0,0,2.1,-1.1,-0.4,1,-2,270\n"
+            "56300,32.8,34.9,10.0,0,0,0,2.2,-1.2,-0.6,1,-2,270\n");
+  const std::string gt = WriteFile(dir + "/GT.csv", GtText(3));
+  const std::vector<NavState> s = ReadAllSamples(*OpenAnsflGt(gt));
   ASSERT_EQ(s.size(), 3u);
   EXPECT_NEAR(s[0].lat_rad, 32.8 * kDegToRad, 1e-15);
   EXPECT_NEAR(s[0].h_m, 10.0, 1e-9);
@@ -226,9 +198,10 @@ TEST(AnsflTest, GtWithExtendedTakesOriginAndSpeedsAndChecksPairing) {
   const wgs84::Geodetic origin{32.8 * kDegToRad, 34.9 * kDegToRad, 10.0};
   const Eigen::Vector3d ned = wgs84::GeodeticToNed({s[2].lat_rad, s[2].lon_rad, s[2].h_m}, origin);
   EXPECT_LT((ned - Eigen::Vector3d(0.4, -0.2, -0.1)).norm(), 1e-6);
-  Write(dir, "GT.csv", GtText(4));  // one row more than GTExtended.csv
-  ExpectInputError([&] { Gt(gt); }, {"GTExtended.csv", "ends before GT.csv"});
-  const std::vector<NavState> e = Drain<NavState>(OpenAnsflGtExtended(dir + "/GTExtended.csv"));
+  WriteFile(dir + "/GT.csv", GtText(4));  // one row more than GTExtended.csv
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflGt(gt)); },
+                   {"GTExtended.csv", "ends before GT.csv"});
+  const std::vector<NavState> e = ReadAllSamples(*OpenAnsflGtExtended(dir + "/GTExtended.csv"));
   ASSERT_EQ(e.size(), 3u);
   EXPECT_NEAR(e[0].t_s, 56.1, 1e-12);
 }
@@ -246,20 +219,20 @@ TEST(AnsflRealDataTest, EveryPathImuLoadsAt120HzAndGtLoads) {
   for (const std::string& folder : PathFolders()) {
     for (int k = 1; k <= 4; ++k) {
       const std::string path = root + "/" + folder + "/IMU_" + std::to_string(k) + ".csv";
-      const std::vector<ImuSample> s = Imu(path);
+      const std::vector<ImuSample> s = ReadAllSamples(*OpenAnsflImu(path));
       ASSERT_GT(s.size(), 100u) << path;
       const double rate = static_cast<double>(s.size() - 1) / (s.back().t_s - s.front().t_s);
       EXPECT_NEAR(rate, 120.0, 1.0) << path;
     }
     const std::string gt = root + "/" + folder + "/GT.csv";
-    EXPECT_EQ(Gt(gt).size(), CountLines(gt) - 1) << gt;
+    EXPECT_EQ(ReadAllSamples(*OpenAnsflGt(gt)).size(), CountLines(gt) - 1) << gt;
   }
 }
 
 TEST(AnsflRealDataTest, StraightLinePath1ImuCountAndAxes) {
   const std::string path = testing::DataPath("ansfl-quadrotor/StraightLine/path_1/IMU_1.csv");
   NAVTWIN_REQUIRE_DATA(path);
-  const std::vector<ImuSample> s = Imu(path);
+  const std::vector<ImuSample> s = ReadAllSamples(*OpenAnsflImu(path));
   // 2881 lines = header + 2880 rate rows; the first row only starts the series.
   ASSERT_EQ(CountLines(path), 2881u);
   ASSERT_EQ(s.size(), 2879u);
@@ -278,7 +251,7 @@ TEST(AnsflRealDataTest, StraightLinePath1ImuCountAndAxes) {
 TEST(AnsflRealDataTest, ProcessedLostSampleRowsAreRetimed) {
   const std::string path = testing::DataPath("ansfl-quadrotor/Horizontal/path_9/IMU_2.csv");
   NAVTWIN_REQUIRE_DATA(path);
-  const std::vector<ImuSample> s = Imu(path);
+  const std::vector<ImuSample> s = ReadAllSamples(*OpenAnsflImu(path));
   ASSERT_EQ(s.size(), CountLines(path) - 2);
   // Line 2251 repeats 18.757583 after a double interval from 18.740917: it becomes the
   // middle, 18.74925 (times printed to 1e-6 s).
@@ -298,9 +271,9 @@ TEST(AnsflRealDataTest, GtAgreesWithGtExtendedOnStraightLinePaths) {
   NAVTWIN_REQUIRE_DATA(root);
   for (int p = 1; p <= 4; ++p) {
     const std::string folder = root + "/path_" + std::to_string(p);
-    const std::vector<NavState> gt = Gt(folder + "/GT.csv");
+    const std::vector<NavState> gt = ReadAllSamples(*OpenAnsflGt(folder + "/GT.csv"));
     const std::vector<NavState> ext =
-        Drain<NavState>(OpenAnsflGtExtended(folder + "/GTExtended.csv"));
+        ReadAllSamples(*OpenAnsflGtExtended(folder + "/GTExtended.csv"));
     ASSERT_EQ(gt.size(), ext.size());
     for (std::size_t k = 0; k < gt.size(); ++k) {
       const Eigen::Vector3d d = wgs84::GeodeticToNed({gt[k].lat_rad, gt[k].lon_rad, gt[k].h_m},
@@ -328,7 +301,7 @@ TEST(AnsflRealDataTest, RawDotFilesLoad) {
     const bool dot7_late =
         std::string(f).find("DOT7_D422CD004217_20220707_111437") != std::string::npos;
     const bool dot4 = std::string(f).find("DOT4") != std::string::npos;
-    const std::vector<ImuSample> s = RawImu(path);
+    const std::vector<ImuSample> s = ReadAllSamples(*OpenAnsflDotRawImu(path));
     // Minus the all-zero first row, the series start and (DOT7, 11:14:37) one lost row.
     EXPECT_EQ(s.size(), rows - 2 - (dot7_late ? 1 : 0)) << f;
     const double rate = static_cast<double>(s.size() - 1) / (s.back().t_s - s.front().t_s);
@@ -336,7 +309,7 @@ TEST(AnsflRealDataTest, RawDotFilesLoad) {
     if (dot4) {
       ExpectInputError([&] { OpenAnsflDotRawMag(path); }, {"Mag_X"});
     } else {
-      EXPECT_EQ(Drain<MagSample>(OpenAnsflDotRawMag(path)).size(), rows) << f;
+      EXPECT_EQ(ReadAllSamples(*OpenAnsflDotRawMag(path)).size(), rows) << f;
     }
   }
 }

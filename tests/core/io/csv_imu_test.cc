@@ -3,43 +3,20 @@
 
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
 
-#include "core/io/input_error.h"
 #include "core/rotation.h"
+#include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "navtwin_csv_imu_" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const std::string& p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
-
-std::vector<ImuSample> ReadAll(const std::string& path) {
-  auto reader = OpenCsvImu(path);
-  std::vector<ImuSample> out;
-  ImuSample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
+using testing::ExpectInputError;
+using testing::ReadAllSamples;
+using testing::TempFilePath;
+using testing::WriteTempFile;
 
 TEST(CsvImuTest, IncrementRoundTripIsExact) {
   std::mt19937 rng(99);
@@ -54,11 +31,11 @@ TEST(CsvImuTest, IncrementRoundTripIsExact) {
   }
   for (std::size_t k = 1; k < in.size(); ++k) in[k].dt_s = in[k].t_s - in[k - 1].t_s;
   in[0].dt_s = in[1].dt_s;
-  const std::string path = ::testing::TempDir() + "navtwin_csv_imu_roundtrip.csv";
+  const std::string path = TempFilePath("roundtrip.csv");
   CsvImuWriter w(path);
   for (const ImuSample& s : in) w.Write(s);
   w.Commit();
-  const std::vector<ImuSample> out = ReadAll(path);
+  const std::vector<ImuSample> out = ReadAllSamples(*OpenCsvImu(path));
   ASSERT_EQ(out.size(), in.size());
   for (std::size_t k = 0; k < in.size(); ++k) {  // 17 digits: exact
     EXPECT_EQ(out[k].t_s, in[k].t_s);
@@ -71,13 +48,13 @@ TEST(CsvImuTest, IncrementRoundTripIsExact) {
 TEST(CsvImuTest, RatesWithPeopleUnitsInAnyOrderAndExtraColumns) {
   // Constant rates: the trapezoid gives rate * dt exactly up to rounding (1e-15).
   const std::string path =
-      WriteTemp("rates.csv",
-                "# recorded on the bench\n"
-                "note,acc_z_g,t_ms,gyro_x_dps,acc_x_mps2,gyro_y_rad_s,gyro_z_dps,acc_y_g\n"
-                "a,1,1000,90,0.5,0.1,-45,0\n"
-                "b,1,1010,90,0.5,0.1,-45,0\n"
-                "c,1,1030,90,0.5,0.1,-45,0\n");
-  const std::vector<ImuSample> out = ReadAll(path);
+      WriteTempFile("rates.csv",
+                    "# recorded on the bench\n"
+                    "note,acc_z_g,t_ms,gyro_x_dps,acc_x_mps2,gyro_y_rad_s,gyro_z_dps,acc_y_g\n"
+                    "a,1,1000,90,0.5,0.1,-45,0\n"
+                    "b,1,1010,90,0.5,0.1,-45,0\n"
+                    "c,1,1030,90,0.5,0.1,-45,0\n");
+  const std::vector<ImuSample> out = ReadAllSamples(*OpenCsvImu(path));
   ASSERT_EQ(out.size(), 2u);  // the first rate row only starts the series
   EXPECT_NEAR(out[0].t_s, 1.010, 1e-15);
   EXPECT_NEAR(out[0].dt_s, 0.010, 1e-15);
@@ -92,32 +69,36 @@ TEST(CsvImuTest, RatesWithPeopleUnitsInAnyOrderAndExtraColumns) {
 
 TEST(CsvImuTest, MissingColumnIsNamed) {
   const std::string rates =
-      WriteTemp("missing_gyro.csv",
-                "t_s,gyro_x_rad_s,gyro_z_rad_s,acc_x_mps2,acc_y_mps2,acc_z_mps2\n"
-                "0,0,0,0,0,0\n");
-  ExpectInputError([&] { ReadAll(rates); },
+      WriteTempFile("missing_gyro.csv",
+                    "t_s,gyro_x_rad_s,gyro_z_rad_s,acc_x_mps2,acc_y_mps2,acc_z_mps2\n"
+                    "0,0,0,0,0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(rates)); },
                    {rates, "line 1", "missing column 'gyro_y_rad_s' or 'gyro_y_dps'"});
-  const std::string inc = WriteTemp("missing_dv.csv",
-                                    "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps\n"
-                                    "0,0,0,0,0,0\n");
-  ExpectInputError([&] { ReadAll(inc); }, {"missing column 'dv_z_mps'"});
-  const std::string time = WriteTemp("missing_t.csv", "time,dtheta_x_rad\n0,0\n");
-  ExpectInputError([&] { ReadAll(time); }, {"missing column 't_s' or 't_ms'"});
+  const std::string inc =
+      WriteTempFile("missing_dv.csv",
+                    "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps\n"
+                    "0,0,0,0,0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(inc)); }, {"missing column 'dv_z_mps'"});
+  const std::string time = WriteTempFile("missing_t.csv", "time,dtheta_x_rad\n0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(time)); }, {"missing column 't_s' or 't_ms'"});
 }
 
 TEST(CsvImuTest, BadRowsNameLineAndField) {
   const std::string head =
       "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n";
-  const std::string nan = WriteTemp("nan.csv", head + "0,0,0,0,0,0,0\n0.01,0,NaN,0,0,0,0\n");
-  ExpectInputError([&] { ReadAll(nan); }, {"line 3", "field 'dtheta_y_rad'", "not a finite"});
-  const std::string back = WriteTemp("back.csv", head + "0,0,0,0,0,0,0\n-0.01,0,0,0,0,0,0\n");
-  ExpectInputError([&] { ReadAll(back); }, {"line 3", "field 't_s'", "does not increase"});
-  const std::string cols = WriteTemp("cols.csv", head + "0,0,0,0,0,0\n");
-  ExpectInputError([&] { ReadAll(cols); }, {"line 2", "expected 7 columns, found 6"});
-  const std::string empty = WriteTemp("empty.csv", "");
-  ExpectInputError([&] { ReadAll(empty); }, {empty, "empty"});
-  const std::string header_only = WriteTemp("header_only.csv", head);
-  ExpectInputError([&] { ReadAll(header_only); }, {"no samples"});
+  const std::string nan = WriteTempFile("nan.csv", head + "0,0,0,0,0,0,0\n0.01,0,NaN,0,0,0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(nan)); },
+                   {"line 3", "field 'dtheta_y_rad'", "not a finite"});
+  const std::string back = WriteTempFile("back.csv", head + "0,0,0,0,0,0,0\n-0.01,0,0,0,0,0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(back)); },
+                   {"line 3", "field 't_s'", "does not increase"});
+  const std::string cols = WriteTempFile("cols.csv", head + "0,0,0,0,0,0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(cols)); },
+                   {"line 2", "expected 7 columns, found 6"});
+  const std::string empty = WriteTempFile("empty.csv", "");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(empty)); }, {empty, "empty"});
+  const std::string header_only = WriteTempFile("header_only.csv", head);
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(header_only)); }, {"no samples"});
 }
 
 }  // namespace

@@ -9,52 +9,16 @@
 #include <string>
 #include <vector>
 
-#include "core/io/input_error.h"
 #include "core/rotation.h"
+#include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
 namespace {
 
-std::string TempPath(const std::string& name) {
-  return ::testing::TempDir() + "navtwin_kfgins_" + name;
-}
-
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = TempPath(name);
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const std::string& p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
-
-template <typename Reader, typename Sample>
-std::vector<Sample> ReadAll(Reader reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
-
-std::vector<ImuSample> ReadImu(const std::string& path) {
-  return ReadAll<std::unique_ptr<ImuReader>, ImuSample>(OpenKfginsImu(path));
-}
-std::vector<GnssSample> ReadGnss(const std::string& path) {
-  return ReadAll<std::unique_ptr<GnssReader>, GnssSample>(OpenKfginsGnss(path));
-}
-std::vector<NavState> ReadNav(const std::string& path) {
-  return ReadAll<std::unique_ptr<NavReader>, NavState>(OpenKfginsNav(path));
-}
+using testing::ExpectInputError;
+using testing::ReadAllSamples;
+using testing::TempFilePath;
+using testing::WriteTempFile;
 
 /// IMU samples at ~200 Hz with jittered time tags, dt consistent with the tags (the first
 /// dt equal to the second interval, as the reader reconstructs it).
@@ -77,11 +41,11 @@ std::vector<ImuSample> RandomImu(int n) {
 
 TEST(KfginsTest, ImuRoundTripIsExact) {
   const std::vector<ImuSample> in = RandomImu(500);
-  const std::string path = TempPath("imu_roundtrip.txt");
+  const std::string path = TempFilePath("imu_roundtrip.txt");
   KfginsImuWriter w(path);
   for (const ImuSample& s : in) w.Write(s);
   w.Commit();
-  const std::vector<ImuSample> out = ReadImu(path);
+  const std::vector<ImuSample> out = ReadAllSamples(*OpenKfginsImu(path));
   ASSERT_EQ(out.size(), in.size());
   // 17 significant digits round-trip a double exactly, so everything compares equal.
   for (std::size_t k = 0; k < in.size(); ++k) {
@@ -93,13 +57,13 @@ TEST(KfginsTest, ImuRoundTripIsExact) {
 }
 
 TEST(KfginsTest, ReadsKfginsStyleWhitespaceAndCommas) {
-  const std::string path = WriteTemp("imu_styles.txt",
-                                     "  100.000  1e-4 2e-4 3e-4   0.01 0.02 -0.049\n"
-                                     "\n"
-                                     "100.005,1e-4,2e-4,3e-4,0.01,0.02,-0.049\r\n"
-                                     "# a comment line\n"
-                                     "100.011\t1e-4\t2e-4\t3e-4\t0.01\t0.02\t-0.049\n");
-  const std::vector<ImuSample> out = ReadImu(path);
+  const std::string path = WriteTempFile("imu_styles.txt",
+                                         "  100.000  1e-4 2e-4 3e-4   0.01 0.02 -0.049\n"
+                                         "\n"
+                                         "100.005,1e-4,2e-4,3e-4,0.01,0.02,-0.049\r\n"
+                                         "# a comment line\n"
+                                         "100.011\t1e-4\t2e-4\t3e-4\t0.01\t0.02\t-0.049\n");
+  const std::vector<ImuSample> out = ReadAllSamples(*OpenKfginsImu(path));
   ASSERT_EQ(out.size(), 3u);
   // Differences of decimal time tags: exact to 1e-9 s (values near 100 s).
   EXPECT_NEAR(out[0].dt_s, 0.005, 1e-9);
@@ -122,11 +86,11 @@ TEST(KfginsTest, GnssRoundTripWithAndWithoutVelocity) {
       g.v_n_mps = Eigen::Vector3d(1.5, -0.25, 0.01 * k);
       g.vel_std_ned_mps = Eigen::Vector3d(0.05, 0.05, 0.08);
     }
-    const std::string path = TempPath(velocity ? "gnss13.txt" : "gnss7.txt");
+    const std::string path = TempFilePath(velocity ? "gnss13.txt" : "gnss7.txt");
     KfginsGnssWriter w(path);
     for (const GnssSample& g : in) w.Write(g);
     w.Commit();
-    const std::vector<GnssSample> out = ReadGnss(path);
+    const std::vector<GnssSample> out = ReadAllSamples(*OpenKfginsGnss(path));
     ASSERT_EQ(out.size(), in.size());
     for (std::size_t k = 0; k < in.size(); ++k) {
       EXPECT_EQ(out[k].t_s, in[k].t_s);
@@ -157,11 +121,11 @@ TEST(KfginsTest, NavRoundTripAndUnknownWeekWrittenAsZero) {
     s.v_n_mps = Eigen::Vector3d(0.5, -1.0, 0.02);
     s.q_n_b = QuatFromEuler(0.01 * k, -0.2, 2.5 - 0.3 * k);
   }
-  const std::string path = TempPath("nav.txt");
+  const std::string path = TempFilePath("nav.txt");
   KfginsNavWriter w(path);
   for (const NavState& s : in) w.Write(s);
   w.Commit();
-  const std::vector<NavState> out = ReadNav(path);
+  const std::vector<NavState> out = ReadAllSamples(*OpenKfginsNav(path));
   ASSERT_EQ(out.size(), in.size());
   for (std::size_t k = 0; k < in.size(); ++k) {
     EXPECT_EQ(out[k].gps_week, k < 5 ? 0 : 2381);
@@ -175,17 +139,17 @@ TEST(KfginsTest, NavRoundTripAndUnknownWeekWrittenAsZero) {
 }
 
 TEST(KfginsTest, WritersRefuseValuesTheReadersWouldReject) {
-  KfginsGnssWriter w(TempPath("refused.txt"));
+  KfginsGnssWriter w(TempFilePath("refused.txt"));
   GnssSample g;  // sigma NaN by default
   EXPECT_THROW(w.Write(g), std::invalid_argument);
-  KfginsImuWriter wi(TempPath("refused_imu.txt"));
+  KfginsImuWriter wi(TempFilePath("refused_imu.txt"));
   ImuSample s;
   s.dv_b_mps.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(wi.Write(s), std::invalid_argument);
 }
 
 TEST(KfginsTest, UncommittedWriterLeavesNoFile) {
-  const std::string path = TempPath("uncommitted.txt");
+  const std::string path = TempFilePath("uncommitted.txt");
   std::remove(path.c_str());
   {
     KfginsImuWriter w(path);
@@ -202,47 +166,55 @@ TEST(KfginsTest, TimeBackwardsAtLine1234IsReportedThere) {
     text.precision(17);
     text << t << " 0 0 0 0 0 -0.049\n";
   }
-  const std::string path = WriteTemp("backwards.txt", text.str());
-  ExpectInputError([&] { ReadImu(path); }, {path, "line 1234", "field 't'", "does not increase"});
+  const std::string path = WriteTempFile("backwards.txt", text.str());
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(path)); },
+                   {path, "line 1234", "field 't'", "does not increase"});
 }
 
 TEST(KfginsTest, BadInputMessagesNameFileLineAndField) {
   const std::string good = "100.000 0 0 0 0 0 -0.049\n";
-  const std::string malformed = WriteTemp("malformed.txt", good + "100.005 0 0 0 0 0\n");
-  ExpectInputError([&] { ReadImu(malformed); },
+  const std::string malformed = WriteTempFile("malformed.txt", good + "100.005 0 0 0 0 0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(malformed)); },
                    {malformed, "line 2", "expected 7 columns, found 6"});
-  const std::string nan = WriteTemp("nan.txt", good + "100.005 0 0 0 0 nan -0.049\n");
-  ExpectInputError([&] { ReadImu(nan); }, {"line 2", "field 'dv_y'", "not a finite number"});
-  const std::string text = WriteTemp("text.txt", good + "100.005 0 0 abc 0 0 -0.049\n");
-  ExpectInputError([&] { ReadImu(text); }, {"line 2", "field 'dtheta_z'", "not a number: 'abc'"});
-  const std::string empty = WriteTemp("empty.txt", "");
-  ExpectInputError([&] { ReadImu(empty); }, {empty, "empty"});
-  const std::string blank = WriteTemp("blank.txt", "\n  \n");
-  ExpectInputError([&] { ReadGnss(blank); }, {blank, "empty"});
-  const std::string single = WriteTemp("single.txt", good);
-  ExpectInputError([&] { ReadImu(single); }, {"line 1", "at least two lines"});
+  const std::string nan = WriteTempFile("nan.txt", good + "100.005 0 0 0 0 nan -0.049\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(nan)); },
+                   {"line 2", "field 'dv_y'", "not a finite number"});
+  const std::string text = WriteTempFile("text.txt", good + "100.005 0 0 abc 0 0 -0.049\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(text)); },
+                   {"line 2", "field 'dtheta_z'", "not a number: 'abc'"});
+  const std::string empty = WriteTempFile("empty.txt", "");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(empty)); }, {empty, "empty"});
+  const std::string blank = WriteTempFile("blank.txt", "\n  \n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(blank)); }, {blank, "empty"});
+  const std::string single = WriteTempFile("single.txt", good);
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(single)); },
+                   {"line 1", "at least two lines"});
 }
 
 TEST(KfginsTest, GnssValidation) {
-  const std::string zero_sigma =
-      WriteTemp("zero_sigma.txt", "1 30.5 114.2 20 0.01 0.01 0.02\n2 30.5 114.2 20 0.01 0 0.02\n");
-  ExpectInputError([&] { ReadGnss(zero_sigma); }, {"line 2", "field 'sigma_e'", "must be > 0"});
-  const std::string mixed =
-      WriteTemp("mixed.txt",
-                "1 30.5 114.2 20 0.01 0.01 0.02\n2 30.5 114.2 20 0.01 0.01 0.02 1 2 3 .1 .1 .1\n");
-  ExpectInputError([&] { ReadGnss(mixed); }, {"line 2", "expected 7 columns, found 13"});
-  const std::string lat = WriteTemp("lat.txt", "1 91 114.2 20 0.01 0.01 0.02\n");
-  ExpectInputError([&] { ReadGnss(lat); }, {"line 1", "field 'lat'"});
-  const std::string count = WriteTemp("count.txt", "1 30.5 114.2 20 0.01 0.01\n");
-  ExpectInputError([&] { ReadGnss(count); }, {"line 1", "expected 7 or 13 columns, found 6"});
+  const std::string zero_sigma = WriteTempFile(
+      "zero_sigma.txt", "1 30.5 114.2 20 0.01 0.01 0.02\n2 30.5 114.2 20 0.01 0 0.02\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(zero_sigma)); },
+                   {"line 2", "field 'sigma_e'", "must be > 0"});
+  const std::string mixed = WriteTempFile(
+      "mixed.txt",
+      "1 30.5 114.2 20 0.01 0.01 0.02\n2 30.5 114.2 20 0.01 0.01 0.02 1 2 3 .1 .1 .1\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(mixed)); },
+                   {"line 2", "expected 7 columns, found 13"});
+  const std::string lat = WriteTempFile("lat.txt", "1 91 114.2 20 0.01 0.01 0.02\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(lat)); }, {"line 1", "field 'lat'"});
+  const std::string count = WriteTempFile("count.txt", "1 30.5 114.2 20 0.01 0.01\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(count)); },
+                   {"line 1", "expected 7 or 13 columns, found 6"});
 }
 
 TEST(KfginsTest, NavValidation) {
-  const std::string back =
-      WriteTemp("nav_back.txt", "2381 10 30 114 20 0 0 0 0 0 0\n2381 9 30 114 20 0 0 0 0 0 0\n");
-  ExpectInputError([&] { ReadNav(back); }, {"line 2", "field 'sow'", "does not increase"});
-  const std::string week = WriteTemp("nav_week.txt", "2381.5 10 30 114 20 0 0 0 0 0 0\n");
-  ExpectInputError([&] { ReadNav(week); }, {"line 1", "field 'week'"});
+  const std::string back = WriteTempFile(
+      "nav_back.txt", "2381 10 30 114 20 0 0 0 0 0 0\n2381 9 30 114 20 0 0 0 0 0 0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsNav(back)); },
+                   {"line 2", "field 'sow'", "does not increase"});
+  const std::string week = WriteTempFile("nav_week.txt", "2381.5 10 30 114 20 0 0 0 0 0 0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsNav(week)); }, {"line 1", "field 'week'"});
 }
 
 }  // namespace

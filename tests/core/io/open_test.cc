@@ -2,42 +2,19 @@
 #include "core/io/open.h"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
-#include <fstream>
 #include <set>
 #include <string>
 
-#include "core/io/input_error.h"
+#include "tests/core/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace navtwin {
 namespace {
 
-std::string MakeTempDir() {
-  std::string pattern = ::testing::TempDir() + "navtwin_open_XXXXXX";
-  if (mkdtemp(pattern.data()) == nullptr) ADD_FAILURE() << "mkdtemp failed";
-  return pattern;
-}
-
-std::string Write(const std::string& dir, const std::string& name, const std::string& text) {
-  const std::string path = dir + "/" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const std::string& p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
+using testing::ExpectInputError;
+using testing::MakeTempDir;
+using testing::WriteFile;
 
 TEST(OpenTest, DetectsEveryTextKindFromItsFirstLines) {
   const std::string d = MakeTempDir();
@@ -76,12 +53,12 @@ TEST(OpenTest, DetectsEveryTextKindFromItsFirstLines) {
       {"other.csv", "a,b,c\n", FileFormat::kUnknown},
   };
   for (const Case& c : cases) {
-    EXPECT_EQ(DetectFormat(Write(d, c.name, c.text)), c.format) << c.name;
+    EXPECT_EQ(DetectFormat(WriteFile(d + "/" + c.name, c.text)), c.format) << c.name;
   }
-  const std::string raw = Write(d, "imu_walk.csv", "0.01,-0.02,1.0,0.5,-0.25,9.0,1000\n");
-  Write(d, "imu_walk.csv.tag", "TIMETAG RTKLIB");
+  const std::string raw = WriteFile(d + "/imu_walk.csv", "0.01,-0.02,1.0,0.5,-0.25,9.0,1000\n");
+  WriteFile(d + "/imu_walk.csv.tag", "TIMETAG RTKLIB");
   EXPECT_EQ(DetectFormat(raw), FileFormat::kRtklibWalkImu);
-  EXPECT_EQ(DetectFormat(Write(d, "log.ulg", "not really")), FileFormat::kULog);
+  EXPECT_EQ(DetectFormat(WriteFile(d + "/log.ulg", "not really")), FileFormat::kULog);
 }
 
 TEST(OpenTest, FormatNamesAreDistinct) {
@@ -95,7 +72,8 @@ TEST(OpenTest, FormatNamesAreDistinct) {
 
 TEST(OpenTest, RefusesStreamsAKindDoesNotHold) {
   const std::string d = MakeTempDir();
-  const std::string imu = Write(d, "imu.txt", "1.000 0 0 0 0 0 -0.049\n1.005 0 0 0 0 0 -0.049\n");
+  const std::string imu =
+      WriteFile(d + "/imu.txt", "1.000 0 0 0 0 0 -0.049\n1.005 0 0 0 0 0 -0.049\n");
   ImuSample s;
   EXPECT_TRUE(OpenImu(imu)->Next(&s));
   ExpectInputError([&] { OpenGnss(imu); },
@@ -103,19 +81,19 @@ TEST(OpenTest, RefusesStreamsAKindDoesNotHold) {
   ExpectInputError([&] { OpenNav(imu); }, {"cannot read navigation states"});
   ExpectInputError([&] { OpenMag(imu); }, {"cannot read magnetometer samples"});
   ExpectInputError([&] { OpenBaro(imu); }, {"cannot read barometer samples"});
-  const std::string unknown = Write(d, "five.txt", "1 2 3 4 5\n");
+  const std::string unknown = WriteFile(d + "/five.txt", "1 2 3 4 5\n");
   ExpectInputError([&] { OpenImu(unknown); }, {"of kind unknown"});
   ExpectInputError([&] { DescribeFile(unknown); }, {"not a recognised format"});
-  const std::string empty = Write(d, "empty.txt", "");
+  const std::string empty = WriteFile(d + "/empty.txt", "");
   ExpectInputError([&] { OpenImu(empty); }, {empty, "empty"});
 }
 
 TEST(OpenTest, DescribesATextFile) {
   const std::string d = MakeTempDir();
   const std::string imu =
-      Write(d, "imu.csv",
-            "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
-            "1.00,0,0,0,0,0,0\n1.01,0,0,0,0,0,0\n1.02,0,0,0,0,0,0\n1.05,0,0,0,0,0,0\n");
+      WriteFile(d + "/imu.csv",
+                "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
+                "1.00,0,0,0,0,0,0\n1.01,0,0,0,0,0,0\n1.02,0,0,0,0,0,0\n1.05,0,0,0,0,0,0\n");
   const FileSummary f = DescribeFile(imu);
   EXPECT_EQ(f.kind, "csv-imu");
   ASSERT_EQ(f.streams.size(), 1u);

@@ -4,43 +4,19 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <string>
 #include <vector>
 
-#include "core/io/input_error.h"
 #include "core/rotation.h"
+#include "tests/core/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace navtwin {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "navtwin_pos_" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const std::string& p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
-
-std::vector<GnssSample> ReadAll(const std::string& path) {
-  auto reader = OpenRtklibPos(path);
-  std::vector<GnssSample> out;
-  GnssSample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
+using testing::ExpectInputError;
+using testing::ReadAllSamples;
+using testing::WriteTempFile;
 
 const char kHeader[] =
     "% program   : RTKLIB ver.demo5\n"
@@ -52,10 +28,10 @@ const char kTail[] =
     "0.0000   0.00    0.0   0.1 0.2 0.3  0.04 0.05 0.06 0 0 0\n";
 
 TEST(RtklibPosTest, CalendarTimeLlhAndVelocity) {
-  const std::string path = WriteTemp(
+  const std::string path = WriteTempFile(
       "good.pos", std::string(kHeader) + "2025/08/28 17:30:39.749   40.096691600 -105.147166500" +
                       kTail + "2025/08/28 17:30:39.999   40.096691600 -105.147166500" + kTail);
-  const std::vector<GnssSample> g = ReadAll(path);
+  const std::vector<GnssSample> g = ReadAllSamples(*OpenRtklibPos(path));
   ASSERT_EQ(g.size(), 2u);
   // 2025-08-28 is a Thursday of GPS week 2381: 4 days + 17:30:39.749.
   EXPECT_EQ(g[0].gps_week, 2381);
@@ -73,13 +49,13 @@ TEST(RtklibPosTest, CalendarTimeLlhAndVelocity) {
 }
 
 TEST(RtklibPosTest, WeekTowTimeAndNoVelocityColumns) {
-  const std::string path = WriteTemp(
+  const std::string path = WriteTempFile(
       "weektow.pos",
       "%  GPST          latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   "
       "sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n"
       "2381 604799.500 40.1 -105.1 1601.4 5 9 1.5 1.5 3.0 0 0 0 0 0\n"
       "2382      0.500 40.1 -105.1 1601.4 5 9 1.5 1.5 3.0 0 0 0 0 0\n");
-  const std::vector<GnssSample> g = ReadAll(path);
+  const std::vector<GnssSample> g = ReadAllSamples(*OpenRtklibPos(path));
   ASSERT_EQ(g.size(), 2u);
   EXPECT_FALSE(g[0].has_velocity);
   // Times count from the first epoch's week, so they keep increasing across the week.
@@ -93,60 +69,68 @@ TEST(RtklibPosTest, UtcNeedsTheLeapSecondsFromTheHeader) {
       "%  UTC                   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   "
       "sde(m)   sdu(m)  sdne(m)  sdeu(m)  sdun(m) age(s)  ratio\n";
   const std::string line = "2025/08/28 17:30:21.749 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2 0 0 0 0 0\n";
-  const std::string refused = WriteTemp("utc.pos", utc_header + line);
-  ExpectInputError([&] { ReadAll(refused); }, {refused, "line 1", "UTC", "leap seconds"});
+  const std::string refused = WriteTempFile("utc.pos", utc_header + line);
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(refused)); },
+                   {refused, "line 1", "UTC", "leap seconds"});
   const std::string with_leap =
-      WriteTemp("utc_leap.pos", "% leap seconds: 18\n" + utc_header + line);
-  const std::vector<GnssSample> g = ReadAll(with_leap);
+      WriteTempFile("utc_leap.pos", "% leap seconds: 18\n" + utc_header + line);
+  const std::vector<GnssSample> g = ReadAllSamples(*OpenRtklibPos(with_leap));
   ASSERT_EQ(g.size(), 1u);
   EXPECT_NEAR(g[0].t_s, 4 * 86400 + 17 * 3600 + 30 * 60 + 39.749, 1e-9);  // UTC + 18 s
 }
 
 TEST(RtklibPosTest, RefusesOtherSolutionFormats) {
-  const std::string xyz = WriteTemp(
+  const std::string xyz = WriteTempFile(
       "xyz.pos",
       "%  GPST                   x-ecef(m)      y-ecef(m)      z-ecef(m)   Q  ns   sdx(m)   "
       "sdy(m)   sdz(m)\n2025/08/28 17:30:39.749 -1 2 3 1 9 0.1 0.1 0.1\n");
-  ExpectInputError([&] { ReadAll(xyz); }, {"x-ecef", "latitude/longitude/height"});
-  const std::string enu =
-      WriteTemp("enu.pos",
-                "%  GPST   e-baseline(m)  n-baseline(m)  u-baseline(m)   Q  ns   sde(m)   sdn(m)   "
-                "sdu(m)\n2025/08/28 17:30:39.749 1 2 3 1 9 0.1 0.1 0.1\n");
-  ExpectInputError([&] { ReadAll(enu); }, {"baseline", "latitude/longitude/height"});
-  const std::string dms =
-      WriteTemp("dms.pos",
-                "%  GPST   latitude(d'\")  longitude(d'\")  height(m)   Q  ns   sdn(m)   sde(m)   "
-                "sdu(m)\n2025/08/28 17:30:39.749 40 5 48.09 -105 8 49.8 1601 1 9 0.1 0.1 0.1\n");
-  ExpectInputError([&] { ReadAll(dms); }, {"deg-min-sec"});
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(xyz)); },
+                   {"x-ecef", "latitude/longitude/height"});
+  const std::string enu = WriteTempFile(
+      "enu.pos",
+      "%  GPST   e-baseline(m)  n-baseline(m)  u-baseline(m)   Q  ns   sde(m)   sdn(m)   "
+      "sdu(m)\n2025/08/28 17:30:39.749 1 2 3 1 9 0.1 0.1 0.1\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(enu)); },
+                   {"baseline", "latitude/longitude/height"});
+  const std::string dms = WriteTempFile(
+      "dms.pos",
+      "%  GPST   latitude(d'\")  longitude(d'\")  height(m)   Q  ns   sdn(m)   sde(m)   "
+      "sdu(m)\n2025/08/28 17:30:39.749 40 5 48.09 -105 8 49.8 1601 1 9 0.1 0.1 0.1\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(dms)); }, {"deg-min-sec"});
   const std::string no_header =
-      WriteTemp("noheader.pos", "2025/08/28 17:30:39.749 40 -105 1601 1 9\n");
-  ExpectInputError([&] { ReadAll(no_header); }, {"column-name header"});
+      WriteTempFile("noheader.pos", "2025/08/28 17:30:39.749 40 -105 1601 1 9\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(no_header)); }, {"column-name header"});
 }
 
 TEST(RtklibPosTest, BadLinesNameLineAndField) {
   const std::string head =
       "%  GPST   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)\n";
   const std::string ok = "2025/08/28 17:30:39.749 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n";
-  const std::string zero = WriteTemp(
+  const std::string zero = WriteTempFile(
       "zero.pos", head + ok + "2025/08/28 17:30:39.999 40.1 -105.1 1601.4 1 9 0 0.1 0.2\n");
-  ExpectInputError([&] { ReadAll(zero); }, {"line 3", "field 'sdn'", "must be > 0"});
-  const std::string back = WriteTemp(
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(zero)); },
+                   {"line 3", "field 'sdn'", "must be > 0"});
+  const std::string back = WriteTempFile(
       "back.pos", head + ok + "2025/08/28 17:30:39.499 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n");
-  ExpectInputError([&] { ReadAll(back); }, {"line 3", "does not increase"});
-  const std::string shortline =
-      WriteTemp("short.pos", head + ok + "2025/08/28 17:30:39.999 40.1 -105.1 1601.4 1 9 0.1\n");
-  ExpectInputError([&] { ReadAll(shortline); }, {"line 3", "expected 10 columns, found 8"});
-  const std::string nan =
-      WriteTemp("nan.pos", head + "2025/08/28 17:30:39.749 nan -105.1 1601.4 1 9 0.1 0.1 0.2\n");
-  ExpectInputError([&] { ReadAll(nan); }, {"line 2", "field 'latitude'", "not a finite number"});
-  const std::string missing = WriteTemp(
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(back)); }, {"line 3", "does not increase"});
+  const std::string shortline = WriteTempFile(
+      "short.pos", head + ok + "2025/08/28 17:30:39.999 40.1 -105.1 1601.4 1 9 0.1\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(shortline)); },
+                   {"line 3", "expected 10 columns, found 8"});
+  const std::string nan = WriteTempFile(
+      "nan.pos", head + "2025/08/28 17:30:39.749 nan -105.1 1601.4 1 9 0.1 0.1 0.2\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(nan)); },
+                   {"line 2", "field 'latitude'", "not a finite number"});
+  const std::string missing = WriteTempFile(
       "missing.pos",
       "%  GPST   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)\n" + ok);
-  ExpectInputError([&] { ReadAll(missing); }, {"line 1", "missing column 'sdu'"});
-  const std::string header_only = WriteTemp("header_only.pos", head);
-  ExpectInputError([&] { ReadAll(header_only); }, {header_only, "no solution epochs"});
-  const std::string empty = WriteTemp("empty.pos", "");
-  ExpectInputError([&] { ReadAll(empty); }, {empty, "column-name header"});
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(missing)); },
+                   {"line 1", "missing column 'sdu'"});
+  const std::string header_only = WriteTempFile("header_only.pos", head);
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(header_only)); },
+                   {header_only, "no solution epochs"});
+  const std::string empty = WriteTempFile("empty.pos", "");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(empty)); }, {empty, "column-name header"});
 }
 
 TEST(RtklibPosTest, GpsTimeHelpers) {
@@ -161,7 +145,7 @@ TEST(RtklibPosTest, GpsTimeHelpers) {
 TEST(RtklibPosTest, RealWalkSolutionFile) {
   const std::string path = testing::DataPath("rtklib-walk/gnss_1730_sf.pos");
   NAVTWIN_REQUIRE_DATA(path);
-  const std::vector<GnssSample> g = ReadAll(path);
+  const std::vector<GnssSample> g = ReadAllSamples(*OpenRtklibPos(path));
   // 536 epochs at 4 Hz (counted with grep; every interval is 0.25 s), RTK fix or float.
   ASSERT_EQ(g.size(), 536u);
   EXPECT_EQ(g.front().gps_week, 2381);

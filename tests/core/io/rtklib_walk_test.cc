@@ -3,7 +3,6 @@
 #include "core/io/rtklib_walk.h"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,37 +13,15 @@
 #include <string>
 #include <vector>
 
-#include "core/io/input_error.h"
+#include "tests/core/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace navtwin {
 namespace {
 
-std::string MakeTempDir() {
-  std::string pattern = ::testing::TempDir() + "navtwin_walk_XXXXXX";
-  if (mkdtemp(pattern.data()) == nullptr) ADD_FAILURE() << "mkdtemp failed";
-  return pattern;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<std::string> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const std::string& p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
-
-std::vector<ImuSample> Drain(std::unique_ptr<ImuReader> reader) {
-  std::vector<ImuSample> out;
-  ImuSample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
+using testing::ExpectInputError;
+using testing::MakeTempDir;
+using testing::ReadAllSamples;
 
 void PutU32(std::string* b, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) b->push_back(static_cast<char>((v >> (8 * i)) & 0xff));
@@ -112,7 +89,7 @@ TEST(RtklibWalkTest, RecoversTheSimulatedClockMapping) {
       // 100 s of receipts floored to 16 ms pin the drift to a few ppm.
       EXPECT_NEAR(c.drift, rec.drift, 5e-6);
     }
-    const std::vector<ImuSample> s = Drain(OpenRtklibWalkImu(path));
+    const std::vector<ImuSample> s = ReadAllSamples(*OpenRtklibWalkImu(path));
     ASSERT_EQ(s.size(), static_cast<std::size_t>(rec.lines - 1));
     // Mapped minus true time: the simulation's 3 ms smallest delay (the mapping gives the
     // latest time consistent with the tags) plus up to ~2 ms from the finite sample of
@@ -146,12 +123,13 @@ TEST(RtklibWalkTest, MalformedLinesOtherThanTheCutEndsAreErrors) {
   const std::size_t end = text.find('\n', pos);
   const std::string broken = text.substr(0, pos) + "0.1,0.2,0.3" + text.substr(end);
   std::ofstream(path, std::ios::binary) << broken;
-  ExpectInputError([&] { Drain(OpenRtklibWalkImu(path)); }, {"imu.csv.tag", "matches neither"});
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImu(path)); },
+                   {"imu.csv.tag", "matches neither"});
   // With tags that match (the broken line's length kept), the line itself is reported.
   std::string same_length =
       text.substr(0, pos) + "0.1,0.2,0.3" + std::string(end - pos - 11, ' ') + text.substr(end);
   std::ofstream(path, std::ios::binary) << same_length;
-  ExpectInputError([&] { Drain(OpenRtklibWalkImu(path)); },
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImu(path)); },
                    {path, "line 10", "expected 7 columns, found 3"});
 }
 
@@ -181,7 +159,7 @@ TEST(RtklibWalkTest, ConvertedFileTimeAndUnits) {
   std::ofstream(path) << "1756402240.9610000,0,0,1,0,0,0.5,0,0,0,0\n"
                          "1756402240.9670007,0,0,1,0,0,0.5,0,0,0,0\n"
                          "1756402240.9730017,0,0,1,0,0,0.5,0,0,0,0\n";
-  const std::vector<ImuSample> s = Drain(OpenRtklibWalkImuSf(path));
+  const std::vector<ImuSample> s = ReadAllSamples(*OpenRtklibWalkImuSf(path));
   ASSERT_EQ(s.size(), 2u);
   // Whole seconds and fraction parsed apart: the 1e-7 s digits survive.
   EXPECT_NEAR(s[0].t_s, 408640.9670007, 1e-9);
@@ -190,7 +168,7 @@ TEST(RtklibWalkTest, ConvertedFileTimeAndUnits) {
   EXPECT_NEAR(s[0].dtheta_b_rad.z() / s[0].dt_s, 0.5, 1e-9);  // rad/s as given
   const std::string bad = dir + "/bad_sf.csv";
   std::ofstream(bad) << "1756402240.9610000,0,0,1,0,0,0.5,0,0,0,0\n1756402240.9670007,0,0,1,0,0\n";
-  ExpectInputError([&] { Drain(OpenRtklibWalkImuSf(bad)); },
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImuSf(bad)); },
                    {"line 2", "expected 11 columns, found 6"});
 }
 
@@ -204,7 +182,7 @@ TEST(RtklibWalkRealDataTest, RawImuWithTagsLoads) {
   EXPECT_EQ(c.paired_lines, 20455u);         // every complete line has a receipt tick
   EXPECT_NEAR(c.tick_period_ms, 15.6, 0.2);  // Windows' 64 Hz tick
   EXPECT_LT(std::fabs(c.drift), 100e-6);     // crystals: tens of ppm
-  const std::vector<ImuSample> s = Drain(OpenRtklibWalkImu(path));
+  const std::vector<ImuSample> s = ReadAllSamples(*OpenRtklibWalkImu(path));
   // 20457 lines: a cut first, 20455 complete, a cut last; the first complete one only
   // starts the series.
   ASSERT_EQ(s.size(), 20454u);
@@ -226,8 +204,8 @@ TEST(RtklibWalkRealDataTest, ConvertedFileTimeScaleAgainstTheTags) {
   const std::string sf_path = testing::DataPath("rtklib-walk/imu_1730_sf.csv");
   NAVTWIN_REQUIRE_DATA(sf_path);
   NAVTWIN_REQUIRE_DATA(raw_path);
-  const std::vector<ImuSample> sf = Drain(OpenRtklibWalkImuSf(sf_path));
-  const std::vector<ImuSample> raw = Drain(OpenRtklibWalkImu(raw_path));
+  const std::vector<ImuSample> sf = ReadAllSamples(*OpenRtklibWalkImuSf(sf_path));
+  const std::vector<ImuSample> raw = ReadAllSamples(*OpenRtklibWalkImu(raw_path));
   ASSERT_EQ(sf.size(), 20454u);  // one row per complete raw line
   ASSERT_EQ(sf.size(), raw.size());
   // The converted time starts at the tag file's open time and ends at the last tag tick

@@ -4,36 +4,19 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <string>
 #include <vector>
 
-#include "core/io/input_error.h"
+#include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + "navtwin_text_reader_" + name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-void ExpectInputError(F f, std::initializer_list<const char*> parts) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    for (const char* p : parts) {
-      EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << e.what() << " lacks: " << p;
-    }
-    return;
-  }
-  ADD_FAILURE() << "no InputError";
-}
+using testing::ExpectInputError;
+using testing::WriteTempFile;
 
 TEST(TextReaderTest, LineReaderHandlesLfCrLfAndCrEndsAndCountsBytes) {
-  const std::string path = WriteTemp("ends.txt", "a\r\nbb\rc\n\nd");
+  const std::string path = WriteTempFile("ends.txt", "a\r\nbb\rc\n\nd");
   LineReader r(path);
   std::string line;
   struct Expected {

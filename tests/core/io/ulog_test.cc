@@ -14,10 +14,13 @@
 #include <vector>
 
 #include "core/io/input_error.h"
+#include "tests/core/io/io_test_util.h"
 #include "tests/test_data.h"
 
 namespace navtwin {
 namespace {
+
+using testing::ReadAllSamples;
 
 // A file name under the test temp folder, unique to this process.
 std::string TempPath(const std::string& name) {
@@ -142,13 +145,6 @@ ULogWriter ImuLog() {
   ULogWriter w;
   w.FlagBits(0).Format(kSensorCombined).Subscribe(0, 0, "sensor_combined");
   return w;
-}
-
-std::vector<ImuSample> ReadAll(ImuReader* reader) {
-  std::vector<ImuSample> samples;
-  ImuSample s;
-  while (reader->Next(&s)) samples.push_back(s);
-  return samples;
 }
 
 bool HasNote(const FileSummary& summary, const std::string& text) {
@@ -286,7 +282,7 @@ TEST(ULogTest, ImuIncrementsFromIntegralTimesAndTimeTags) {
       .Data(0, ImuData(1'005'000, 0.25f, 5000, -9.0f, 5000))
       .Data(0, ImuData(1'009'000, 1.0f, 4000, -8.0f, 0));  // accel integral missing: rate * dt
   auto reader = OpenULogImu(w.Save("imu"));
-  const std::vector<ImuSample> s = ReadAll(reader.get());
+  const std::vector<ImuSample> s = ReadAllSamples(*reader);
   ASSERT_EQ(s.size(), 3u);
   // Tolerances: the rates are floats (e.g. 0.5f is exact, -9.8f is not: 4e-7 relative).
   EXPECT_DOUBLE_EQ(s[0].t_s, 1.0);
@@ -314,7 +310,7 @@ TEST(ULogTest, ImuOldFloatIntegralSecondsAndMissingIntegral) {
       .Data(0, data(2'000'000))
       .Data(0, data(2'004'000));
   auto reader = OpenULogImu(w.Save("imu_old"));
-  const std::vector<ImuSample> s = ReadAll(reader.get());
+  const std::vector<ImuSample> s = ReadAllSamples(*reader);
   ASSERT_EQ(s.size(), 2u);
   // 1e-9 (1e-8 for dv): the float 0.004f differs from 0.004 by 1.9e-10 s.
   EXPECT_NEAR(s[0].dt_s, 0.004, 1e-9);
@@ -327,7 +323,7 @@ TEST(ULogTest, ImuOldFloatIntegralSecondsAndMissingIntegral) {
   ULogWriter z = ImuLog();
   z.Data(0, ImuData(1'000'000, 1.f, 0, -9.f, 0)).Data(0, ImuData(1'005'000, 1.f, 0, -9.f, 0));
   auto zr = OpenULogImu(z.Save("imu_zero"));
-  const std::vector<ImuSample> zs = ReadAll(zr.get());
+  const std::vector<ImuSample> zs = ReadAllSamples(*zr);
   ASSERT_EQ(zs.size(), 1u);
   EXPECT_NEAR(zs[0].dtheta_b_rad.x(), 0.005, 1e-12);  // 1 rad/s * 5 ms from time tags
 }
@@ -366,7 +362,7 @@ TEST(ULogTest, TruncatedFinalRecordIsAcceptedWithNote) {
   const std::string path = w.Save("truncated");
 
   auto reader = OpenULogImu(path);
-  EXPECT_EQ(ReadAll(reader.get()).size(), 4u);
+  EXPECT_EQ(ReadAllSamples(*reader).size(), 4u);
   const FileSummary summary = DescribeULog(path);
   EXPECT_EQ(summary.streams.at(0).count, 4u);
   EXPECT_TRUE(HasNote(summary, "final record cut short at byte " + std::to_string(cut_at)));
@@ -491,7 +487,7 @@ TEST(ULogTest, AppendedDataAfterACutMessageIsRead) {
   const std::string path =
       build(static_cast<std::uint64_t>(appended_at), &appended_at).Save("appended");
   auto reader = OpenULogImu(path);
-  const std::vector<ImuSample> s = ReadAll(reader.get());
+  const std::vector<ImuSample> s = ReadAllSamples(*reader);
   ASSERT_EQ(s.size(), 2u);
   EXPECT_NEAR(s[1].dt_s, 0.010, 1e-12);
   EXPECT_TRUE(
@@ -662,7 +658,7 @@ TEST(ULogRealDataTest, AllLogsDescribeAndReadImu) {
     EXPECT_FALSE(HasNote(summary, "cut short"));
 
     auto reader = OpenULogImu(path);
-    const std::vector<ImuSample> samples = ReadAll(reader.get());
+    const std::vector<ImuSample> samples = ReadAllSamples(*reader);
     EXPECT_EQ(samples.size(), log.imu_count);
     ASSERT_FALSE(samples.empty());
     EXPECT_DOUBLE_EQ(samples.front().t_s, imu->t_first_s);
