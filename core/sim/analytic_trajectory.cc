@@ -4,50 +4,9 @@
 #include <stdexcept>
 
 #include "core/rotation.h"
+#include "core/sim/truth.h"
 
 namespace navtwin::sim {
-namespace {
-
-struct GeoPoint {
-  double lat_rad, lon_rad, h_m;
-};
-
-// d(lat, lon, h)/dt for NED velocity v at (lat, h).
-GeoPoint PositionRate(const GeoPoint& p, const Eigen::Vector3d& v_n) {
-  return {v_n.x() / (wgs84::MeridianRadius(p.lat_rad) + p.h_m),
-          v_n.y() / ((wgs84::PrimeVerticalRadius(p.lat_rad) + p.h_m) * std::cos(p.lat_rad)),
-          -v_n.z()};
-}
-
-GeoPoint Add(const GeoPoint& p, const GeoPoint& d, double s) {
-  return {p.lat_rad + s * d.lat_rad, p.lon_rad + s * d.lon_rad, p.h_m + s * d.h_m};
-}
-
-// One RK4 step of the position ODE from t over h.
-GeoPoint Rk4(const AnalyticTrajectory& tr, const GeoPoint& p, double t, double h) {
-  const GeoPoint k1 = PositionRate(p, tr.Velocity_n_mps(t));
-  const GeoPoint k2 = PositionRate(Add(p, k1, h / 2), tr.Velocity_n_mps(t + h / 2));
-  const GeoPoint k3 = PositionRate(Add(p, k2, h / 2), tr.Velocity_n_mps(t + h / 2));
-  const GeoPoint k4 = PositionRate(Add(p, k3, h), tr.Velocity_n_mps(t + h));
-  return {p.lat_rad + h / 6 * (k1.lat_rad + 2 * k2.lat_rad + 2 * k3.lat_rad + k4.lat_rad),
-          p.lon_rad + h / 6 * (k1.lon_rad + 2 * k2.lon_rad + 2 * k3.lon_rad + k4.lon_rad),
-          p.h_m + h / 6 * (k1.h_m + 2 * k2.h_m + 2 * k3.h_m + k4.h_m)};
-}
-
-NavState TruthState(const AnalyticTrajectory& tr, double t, const GeoPoint& p) {
-  NavState s;
-  s.t_s = t;
-  s.lat_rad = p.lat_rad;
-  s.lon_rad = p.lon_rad;
-  s.h_m = p.h_m;
-  s.v_n_mps = tr.Velocity_n_mps(t);
-  const Eigen::Vector3d e = tr.Euler_rad(t);
-  s.q_n_b = QuatFromEuler(e.x(), e.y(), e.z());
-  return s;
-}
-
-}  // namespace
-
 BodyKinematics BodyKinematicsAt(const AnalyticTrajectory& tr, double t, double lat_rad, double h_m) {
   const Eigen::Vector3d e = tr.Euler_rad(t);
   const Eigen::Vector3d de = tr.EulerRate_rad_s(t);
@@ -72,32 +31,12 @@ void SynthesizeImu(const AnalyticTrajectory& tr, const wgs84::Geodetic& start, d
   if (!(rate_hz > 0.0) || !(duration_s > 0.0)) {
     throw std::invalid_argument("SynthesizeImu: rate_hz and duration_s must be positive");
   }
-  // 3-point Gauss-Legendre nodes on [0, 1] and weights.
-  const double c = std::sqrt(0.6) / 2.0;
-  const double nodes[3] = {0.5 - c, 0.5, 0.5 + c};
-  const double weights[3] = {5.0 / 18.0, 8.0 / 18.0, 5.0 / 18.0};
-
-  const double dt = 1.0 / rate_hz;
+  TruthGenerator truth(tr, start, rate_hz);
+  emit(ImuSample(), truth.current().state);
   const long n = std::lround(duration_s * rate_hz);
-  GeoPoint p{start.lat_rad, start.lon_rad, start.h_m};
-  ImuSample none;
-  emit(none, TruthState(tr, 0.0, p));
   for (long k = 1; k <= n; ++k) {
-    const double t0 = (k - 1) * dt;
-    ImuSample s;
-    s.t_s = k * dt;
-    s.dt_s = dt;
-    double t = t0;
-    for (int i = 0; i < 3; ++i) {
-      const double tn = t0 + nodes[i] * dt;
-      p = Rk4(tr, p, t, tn - t);
-      t = tn;
-      const BodyKinematics kin = BodyKinematicsAt(tr, tn, p.lat_rad, p.h_m);
-      s.dtheta_b_rad += weights[i] * dt * kin.omega_ib_b_rad_s;
-      s.dv_b_mps += weights[i] * dt * kin.f_b_mps2;
-    }
-    p = Rk4(tr, p, t, s.t_s - t);
-    emit(s, TruthState(tr, s.t_s, p));
+    const TruthSample& s = truth.Next();
+    emit(s.exact, s.state);
   }
 }
 

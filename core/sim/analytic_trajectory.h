@@ -7,9 +7,8 @@
 //   omega_ib_b = omega_nb_b + R_b_n (omega_ie_n + omega_en_n)
 //   f_b        = R_b_n (a_n + (2 omega_ie_n + omega_en_n) x v_n - g_n)
 // The increments dtheta = integral of omega_ib_b dt and dv = integral of f_b dt over each
-// sample interval are what an ideal integrating IMU outputs; they are computed with
-// 3-point Gauss-Legendre quadrature (error O(dt^7)), and the geodetic position with RK4
-// along the quadrature nodes.
+// sample interval are what an ideal integrating IMU outputs (core/sim/truth.h computes
+// them).
 #pragma once
 
 #include <functional>
