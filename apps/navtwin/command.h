@@ -20,6 +20,8 @@ struct Command {
 Command InfoCommand();
 Command ConvertCommand();
 Command InsCommand();
+Command SimulateCommand();
+Command AllanCommand();
 
 /// Exit codes shared by all subcommands.
 constexpr int kExitOk = 0;

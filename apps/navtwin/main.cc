@@ -18,7 +18,9 @@ DEFINE_string(format, "text", "Output format of printed results: text or json");
 namespace navtwin::app {
 namespace {
 
-std::vector<Command> AllCommands() { return {InfoCommand(), ConvertCommand(), InsCommand()}; }
+std::vector<Command> AllCommands() {
+  return {InfoCommand(), ConvertCommand(), InsCommand(), SimulateCommand(), AllanCommand()};
+}
 
 void PrintMainHelp(const std::vector<Command>& commands) {
   std::cout << "navtwin — inertial-navigation estimation: filters and their batch twins\n\n"

@@ -1,6 +1,7 @@
 // Output files appear whole or not at all: data goes to a temporary file in the same
 // folder, renamed over the target by Commit(). A writer destroyed without Commit()
 // (an exception, bad input) removes the temporary, so no partial output is left.
+// Doubles written to stream() come out in the shortest form that reads back exactly.
 #pragma once
 
 #include <fstream>

@@ -11,6 +11,7 @@
 
 #include "core/io/ansfl.h"
 #include "core/io/csv_imu.h"
+#include "core/io/csv_mag_baro.h"
 #include "core/io/input_error.h"
 #include "core/io/kfgins.h"
 #include "core/io/rtklib_pos.h"
@@ -67,6 +68,11 @@ FileFormat FromHeader(const HeaderColumns& h) {
       (has("dtheta_x_rad") || has("gyro_x_rad_s") || has("gyro_x_dps"))) {
     return FileFormat::kCsvImu;
   }
+  const bool timed = has("t_s") || has("t_ms");
+  if (timed && (has("mx_uT") || has("mx_G") || has("mx_ga") || has("mx_nT"))) {
+    return FileFormat::kCsvMag;
+  }
+  if (timed && (has("pressure_pa") || has("altitude_m"))) return FileFormat::kCsvBaro;
   return FileFormat::kUnknown;
 }
 
@@ -185,6 +191,10 @@ std::string FormatName(FileFormat format) {
       return "rtklib-walk-imu-sf";
     case FileFormat::kULog:
       return "ulog";
+    case FileFormat::kCsvMag:
+      return "csv-mag";
+    case FileFormat::kCsvBaro:
+      return "csv-baro";
     case FileFormat::kUnknown:
       break;
   }
@@ -244,6 +254,8 @@ std::unique_ptr<NavReader> OpenNav(const std::string& path) {
 std::unique_ptr<MagReader> OpenMag(const std::string& path) {
   const FileFormat format = DetectFormat(path);
   switch (format) {
+    case FileFormat::kCsvMag:
+      return OpenCsvMag(path);
     case FileFormat::kAnsflDotRaw:
       return OpenAnsflDotRawMag(path);
     case FileFormat::kULog:
@@ -256,6 +268,7 @@ std::unique_ptr<MagReader> OpenMag(const std::string& path) {
 std::unique_ptr<BaroReader> OpenBaro(const std::string& path) {
   const FileFormat format = DetectFormat(path);
   if (format == FileFormat::kULog) return OpenULogBaro(path);
+  if (format == FileFormat::kCsvBaro) return OpenCsvBaro(path);
   Refuse(path, "barometer samples", format);
 }
 
@@ -289,6 +302,18 @@ FileSummary DescribeFile(const std::string& path) {
       FileSummary s = Summary(path, format);
       auto reader = OpenCsvImu(path);
       s.streams.push_back(SummarizeStream<ImuSample>(reader.get(), "imu", HeaderNames(path)));
+      return s;
+    }
+    case FileFormat::kCsvMag: {
+      FileSummary s = Summary(path, format);
+      auto reader = OpenCsvMag(path);
+      s.streams.push_back(SummarizeStream<MagSample>(reader.get(), "mag", HeaderNames(path)));
+      return s;
+    }
+    case FileFormat::kCsvBaro: {
+      FileSummary s = Summary(path, format);
+      auto reader = OpenCsvBaro(path);
+      s.streams.push_back(SummarizeStream<BaroSample>(reader.get(), "baro", HeaderNames(path)));
       return s;
     }
     case FileFormat::kKfginsNav:

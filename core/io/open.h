@@ -23,6 +23,8 @@ enum class FileFormat {
   kRtklibWalkImu,
   kRtklibWalkImuSf,
   kULog,
+  kCsvMag,
+  kCsvBaro,
   kUnknown
 };
 
@@ -43,9 +45,9 @@ std::string FormatName(FileFormat format);
 std::unique_ptr<ImuReader> OpenImu(const std::string& path);
 std::unique_ptr<GnssReader> OpenGnss(const std::string& path);
 std::unique_ptr<NavReader> OpenNav(const std::string& path);
-/// Raw Xsens DOT files with Mag columns, and ULog.
+/// navtwin CSV magnetometer files, raw Xsens DOT files with Mag columns, and ULog.
 std::unique_ptr<MagReader> OpenMag(const std::string& path);
-/// ULog only.
+/// navtwin CSV barometer files and ULog.
 std::unique_ptr<BaroReader> OpenBaro(const std::string& path);
 
 /// Kind, and per stream the count, span, rate, gaps and fields with units; notes on

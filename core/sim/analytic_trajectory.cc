@@ -7,22 +7,25 @@
 #include "core/sim/truth.h"
 
 namespace navtwin::sim {
-BodyKinematics BodyKinematicsAt(const AnalyticTrajectory& tr, double t, double lat_rad, double h_m) {
-  const Eigen::Vector3d e = tr.Euler_rad(t);
-  const Eigen::Vector3d de = tr.EulerRate_rad_s(t);
+BodyKinematics BodyKinematicsAt(const TrajectoryPoint& p, double lat_rad, double h_m) {
+  const Eigen::Vector3d& e = p.euler_rad;
+  const Eigen::Vector3d& de = p.euler_rate_rad_s;
   const double sr = std::sin(e.x()), cr = std::cos(e.x());
   const double sp = std::sin(e.y()), cp = std::cos(e.y());
   const Eigen::Vector3d omega_nb_b(de.x() - de.z() * sp, de.y() * cr + de.z() * sr * cp,
                                    -de.y() * sr + de.z() * cr * cp);
   const Eigen::Matrix3d R_b_n = DcmFromEuler(e.x(), e.y(), e.z()).transpose();
-  const Eigen::Vector3d v_n = tr.Velocity_n_mps(t);
   const Eigen::Vector3d w_ie = wgs84::EarthRateNed(lat_rad);
-  const Eigen::Vector3d w_en = wgs84::TransportRateNed(lat_rad, h_m, v_n);
+  const Eigen::Vector3d w_en = wgs84::TransportRateNed(lat_rad, h_m, p.v_n_mps);
   BodyKinematics k;
   k.omega_ib_b_rad_s = omega_nb_b + R_b_n * (w_ie + w_en);
-  k.f_b_mps2 = R_b_n * (tr.Acceleration_n_mps2(t) + (2.0 * w_ie + w_en).cross(v_n) -
+  k.f_b_mps2 = R_b_n * (p.a_n_mps2 + (2.0 * w_ie + w_en).cross(p.v_n_mps) -
                         wgs84::GravityNed(lat_rad, h_m));
   return k;
+}
+
+BodyKinematics BodyKinematicsAt(const AnalyticTrajectory& tr, double t, double lat_rad, double h_m) {
+  return BodyKinematicsAt(tr.PointAt(t), lat_rad, h_m);
 }
 
 void SynthesizeImu(const AnalyticTrajectory& tr, const wgs84::Geodetic& start, double rate_hz,

@@ -20,9 +20,22 @@
 
 namespace navtwin::sim {
 
+/// Everything a trajectory says about one instant.
+struct TrajectoryPoint {
+  Eigen::Vector3d euler_rad;         ///< (roll, pitch, yaw) of R_n_b
+  Eigen::Vector3d euler_rate_rad_s;  ///< their time derivatives
+  Eigen::Vector3d v_n_mps;           ///< velocity over the Earth, NED
+  Eigen::Vector3d a_n_mps2;          ///< its time derivative
+};
+
 class AnalyticTrajectory {
  public:
   virtual ~AnalyticTrajectory() = default;
+  /// The four quantities below at once; trajectories whose four share work override it
+  /// (the truth generator calls it a dozen times per sample).
+  virtual TrajectoryPoint PointAt(double t_s) const {
+    return {Euler_rad(t_s), EulerRate_rad_s(t_s), Velocity_n_mps(t_s), Acceleration_n_mps2(t_s)};
+  }
   /// (roll, pitch, yaw) of R_n_b in rad and their time derivatives in rad/s.
   virtual Eigen::Vector3d Euler_rad(double t_s) const = 0;
   virtual Eigen::Vector3d EulerRate_rad_s(double t_s) const = 0;
@@ -38,6 +51,8 @@ struct BodyKinematics {
 };
 BodyKinematics BodyKinematicsAt(const AnalyticTrajectory& trajectory, double t_s, double lat_rad,
                                 double h_m);
+/// The same from a trajectory point already evaluated.
+BodyKinematics BodyKinematicsAt(const TrajectoryPoint& point, double lat_rad, double h_m);
 
 /// Samples the trajectory at rate_hz from t = 0 (start position `start`) for duration_s.
 /// `emit` receives, for every sample k >= 1, the exact increments over (t_{k-1}, t_k]

@@ -47,10 +47,11 @@ TruthSample TruthGenerator::Sample(double t, const wgs84::Geodetic& p) const {
   s.state.lat_rad = p.lat_rad;
   s.state.lon_rad = p.lon_rad;
   s.state.h_m = p.h_m;
-  s.state.v_n_mps = trajectory_.Velocity_n_mps(t);
-  const Eigen::Vector3d e = trajectory_.Euler_rad(t);
+  const TrajectoryPoint point = trajectory_.PointAt(t);
+  s.state.v_n_mps = point.v_n_mps;
+  const Eigen::Vector3d& e = point.euler_rad;
   s.state.q_n_b = QuatFromEuler(e.x(), e.y(), e.z());
-  const BodyKinematics k = BodyKinematicsAt(trajectory_, t, p.lat_rad, p.h_m);
+  const BodyKinematics k = BodyKinematicsAt(point, p.lat_rad, p.h_m);
   s.omega_ib_b_rad_s = k.omega_ib_b_rad_s;
   s.f_b_mps2 = k.f_b_mps2;
   // Central difference; one-sided at the start (trajectories are defined for t >= 0).
@@ -60,7 +61,7 @@ TruthSample TruthGenerator::Sample(double t, const wgs84::Geodetic& p) const {
       (BodyKinematicsAt(trajectory_, t_hi, p.lat_rad, p.h_m).omega_ib_b_rad_s -
        BodyKinematicsAt(trajectory_, t_lo, p.lat_rad, p.h_m).omega_ib_b_rad_s) /
       (t_hi - t_lo);
-  s.a_n_mps2 = trajectory_.Acceleration_n_mps2(t);
+  s.a_n_mps2 = point.a_n_mps2;
   s.exact.t_s = t;
   return s;
 }

@@ -1,0 +1,170 @@
+#include "core/sim/simulator.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "core/io/atomic_file.h"
+#include "core/io/csv_mag_baro.h"
+#include "core/io/kfgins.h"
+#include "core/rotation.h"
+#include "core/sim/truth.h"
+
+namespace navtwin::sim {
+namespace {
+
+/// The initial state given to an estimator: truth at t = 0 with the configured errors.
+NavState InitialState(const NavState& truth, const InitErrorConfig& e) {
+  NavState s = truth;
+  const wgs84::Geodetic p =
+      wgs84::NedToGeodetic(e.position_ned_m, {truth.lat_rad, truth.lon_rad, truth.h_m});
+  s.lat_rad = p.lat_rad;
+  s.lon_rad = p.lon_rad;
+  s.h_m = p.h_m;
+  s.v_n_mps += e.velocity_ned_mps;
+  // R_true = Exp(phi) R_init  =>  R_init = Exp(-phi) R_true.
+  s.q_n_b = ApplyAttitudeError<double>(-e.attitude_phi_n_rad, truth.q_n_b);
+  return s;
+}
+
+void EmitVector(YAML::Emitter& out, const char* key, const Eigen::Vector3d& v) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << v.z()
+      << YAML::EndSeq;
+}
+
+}  // namespace
+
+SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& options,
+                          const std::string& out_dir) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const Rng rng(options.seed);
+  const bool perfect = options.perfect;
+  SimulationReport report;
+  const auto path = [&](const char* name) {
+    report.files.push_back(out_dir + "/" + name);
+    return report.files.back();
+  };
+
+  ImuSimulator imu(scenario.imu, rng, perfect);
+  TruthGenerator truth(*scenario.trajectory, scenario.start, imu.internal_rate_hz());
+  KfginsImuWriter imu_out(path("imu.txt"));
+  KfginsNavWriter truth_out(path("truth.nav"));
+  KfginsNavWriter init_out(path("init.nav"));
+
+  std::unique_ptr<GnssSimulator> gnss;
+  std::unique_ptr<KfginsGnssWriter> gnss_out;
+  if (scenario.gnss) {
+    gnss = std::make_unique<GnssSimulator>(*scenario.gnss, rng.Stream("gnss"), perfect);
+    gnss_out = std::make_unique<KfginsGnssWriter>(path("gnss.txt"));
+  }
+  std::unique_ptr<MagSimulator> mag;
+  std::unique_ptr<CsvMagWriter> mag_out;
+  if (scenario.mag) {
+    mag = std::make_unique<MagSimulator>(*scenario.mag, scenario.start.lat_rad, rng.Stream("mag"), perfect);
+    mag_out = std::make_unique<CsvMagWriter>(path("mag.csv"));
+  }
+  std::unique_ptr<BaroSimulator> baro;
+  std::unique_ptr<CsvBaroWriter> baro_out;
+  if (scenario.baro) {
+    baro = std::make_unique<BaroSimulator>(*scenario.baro, rng.Stream("baro"), perfect);
+    baro_out = std::make_unique<CsvBaroWriter>(path("baro.csv"));
+  }
+  std::unique_ptr<MasterSimulator> master;
+  std::unique_ptr<KfginsNavWriter> master_out;
+  if (scenario.master) {
+    master = std::make_unique<MasterSimulator>(*scenario.master, rng.Stream("master"), perfect);
+    master_out = std::make_unique<KfginsNavWriter>(path("master.nav"));
+  }
+
+  const long n = std::lround(scenario.duration_s * imu.internal_rate_hz());
+  const long progress_step = std::max(1L, n / 20);
+  for (long k = 0; k <= n; ++k) {
+    const TruthSample& t = k == 0 ? truth.current() : truth.Next();
+    if (k == 0) {
+      truth_out.Write(t.state);
+      init_out.Write(InitialState(t.state, scenario.init_errors));
+    }
+    if (const auto s = imu.Push(t)) {
+      imu_out.Write(*s);
+      truth_out.Write(t.state);
+      ++report.imu_samples;
+    }
+    if (gnss) {
+      if (const auto s = gnss->Push(t)) {
+        gnss_out->Write(*s);
+        ++report.gnss_samples;
+      }
+    }
+    if (mag) {
+      if (const auto s = mag->Push(t)) {
+        mag_out->Write(*s);
+        ++report.mag_samples;
+      }
+    }
+    if (baro) {
+      if (const auto s = baro->Push(t)) {
+        baro_out->Write(*s);
+        ++report.baro_samples;
+      }
+    }
+    if (master) {
+      if (const auto s = master->Push(t)) {
+        master_out->Write(*s);
+        ++report.master_samples;
+      }
+    }
+    if (options.progress && k % progress_step == 0) options.progress(static_cast<double>(k) / n);
+  }
+
+  // errors.yaml: the seed and every drawn value.
+  AtomicFile errors(path("errors.yaml"));
+  YAML::Emitter y;
+  y << YAML::BeginMap;
+  y << YAML::Key << "scenario" << YAML::Value << scenario.name;
+  y << YAML::Key << "seed" << YAML::Value << options.seed;
+  y << YAML::Key << "perfect" << YAML::Value << perfect;
+  y << YAML::Key << "duration_s" << YAML::Value << scenario.duration_s;
+  y << YAML::Key << "imu" << YAML::Value;
+  imu.EmitDrawn(y);
+  if (gnss) {
+    y << YAML::Key << "gnss" << YAML::Value;
+    gnss->EmitDrawn(y);
+  }
+  if (mag) {
+    y << YAML::Key << "mag" << YAML::Value;
+    mag->EmitDrawn(y);
+  }
+  if (baro) {
+    y << YAML::Key << "baro" << YAML::Value;
+    baro->EmitDrawn(y);
+  }
+  if (master) {
+    y << YAML::Key << "master" << YAML::Value;
+    master->EmitDrawn(y);
+  }
+  if (scenario.emit_trajectory) {
+    y << YAML::Key << "trajectory" << YAML::Value;
+    scenario.emit_trajectory(y);
+  }
+  y << YAML::Key << "init_errors" << YAML::Value << YAML::BeginMap;
+  EmitVector(y, "position_ned_m", scenario.init_errors.position_ned_m);
+  EmitVector(y, "velocity_ned_mps", scenario.init_errors.velocity_ned_mps);
+  EmitVector(y, "attitude_phi_n_deg", scenario.init_errors.attitude_phi_n_rad * kRadToDeg);
+  y << YAML::EndMap << YAML::EndMap;
+  errors.stream() << y.c_str() << "\n";
+
+  // Commit only when everything was produced: a failure above leaves no file behind.
+  imu_out.Commit();
+  truth_out.Commit();
+  init_out.Commit();
+  if (gnss_out) gnss_out->Commit();
+  if (mag_out) mag_out->Commit();
+  if (baro_out) baro_out->Commit();
+  if (master_out) master_out->Commit();
+  errors.Commit();
+  report.run_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return report;
+}
+
+}  // namespace navtwin::sim

@@ -1,0 +1,43 @@
+// Runs a scenario and writes its files (formats in docs/formats.md):
+//   imu.txt    KF-GINS IMU increments (the simulated IMU, its own axes and time tags)
+//   truth.nav  KF-GINS navigation format at the IMU rate (body reference point)
+//   init.nav   the initial state an estimator is given (truth + init_errors), one record
+//   gnss.txt   KF-GINS GNSS with velocity (13 columns)       when the scenario has gnss
+//   mag.csv    t_s,mx_uT,my_uT,mz_uT                           when it has mag
+//   baro.csv   t_s,pressure_pa,altitude_m,temperature_degC     when it has baro
+//   master.nav KF-GINS navigation format, delivered late        when it has master
+//   errors.yaml every drawn error value, with units in the keys, and the seed
+// All files appear whole or not at all. Times start at 0 s (GPS week 0).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/sim/scenario.h"
+
+namespace navtwin::sim {
+
+struct SimulationOptions {
+  std::uint64_t seed = 1;
+  bool perfect = false;  ///< every sensor error off (noise, biases, iron, outliers, vibration)
+  /// Called about every 5 % of the run with the fraction done (may be empty).
+  std::function<void(double)> progress;
+};
+
+struct SimulationReport {
+  std::vector<std::string> files;  ///< paths written
+  std::size_t imu_samples = 0;
+  std::size_t gnss_samples = 0;
+  std::size_t mag_samples = 0;
+  std::size_t baro_samples = 0;
+  std::size_t master_samples = 0;
+  double run_time_s = 0.0;
+};
+
+/// Simulates `scenario` into the folder out_dir (which must exist).
+SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& options,
+                          const std::string& out_dir);
+
+}  // namespace navtwin::sim
