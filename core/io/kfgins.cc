@@ -7,6 +7,7 @@
 
 #include "core/io/input_error.h"
 #include "core/io/rate_to_increment.h"
+#include "core/io/text_line.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
 
@@ -196,8 +197,8 @@ void RequireSigma(const Eigen::Vector3d& s, const char* what) {
   if (!(s.minCoeff() > 0.0)) throw std::invalid_argument(std::string(what) + " must be > 0");
 }
 
-void WriteTriple(std::ostream& os, const Eigen::Vector3d& v) {
-  os << ' ' << v.x() << ' ' << v.y() << ' ' << v.z();
+void AddTriple(TextLine& line, const Eigen::Vector3d& v) {
+  line.Char(' ').Number(v.x()).Char(' ').Number(v.y()).Char(' ').Number(v.z());
 }
 
 }  // namespace
@@ -218,11 +219,11 @@ void KfginsImuWriter::Write(const ImuSample& s) {
   RequireFinite(s.t_s, "IMU time");
   RequireFinite(s.dtheta_b_rad, "dtheta");
   RequireFinite(s.dv_b_mps, "dv");
-  std::ostream& os = file_.stream();
-  os << s.t_s;
-  WriteTriple(os, s.dtheta_b_rad);
-  WriteTriple(os, s.dv_b_mps);
-  os << '\n';
+  TextLine line;
+  line.Number(s.t_s);
+  AddTriple(line, s.dtheta_b_rad);
+  AddTriple(line, s.dv_b_mps);
+  line.Char('\n').WriteTo(file_.stream());
 }
 
 void KfginsImuWriter::Commit() { file_.Commit(); }
@@ -238,16 +239,17 @@ void KfginsGnssWriter::Write(const GnssSample& s) {
   RequireFinite(s.t_s, "GNSS time");
   RequireFinite(Eigen::Vector3d(s.lat_rad, s.lon_rad, s.h_m), "GNSS position");
   RequireSigma(s.pos_std_ned_m, "GNSS position sigma");
-  std::ostream& os = file_.stream();
-  os << s.t_s << ' ' << s.lat_rad * kRadToDeg << ' ' << s.lon_rad * kRadToDeg << ' ' << s.h_m;
-  WriteTriple(os, s.pos_std_ned_m);
+  TextLine line;
+  line.Number(s.t_s).Char(' ').Number(s.lat_rad * kRadToDeg).Char(' ');
+  line.Number(s.lon_rad * kRadToDeg).Char(' ').Number(s.h_m);
+  AddTriple(line, s.pos_std_ned_m);
   if (s.has_velocity) {
     RequireFinite(s.v_n_mps, "GNSS velocity");
     RequireSigma(s.vel_std_ned_mps, "GNSS velocity sigma");
-    WriteTriple(os, s.v_n_mps);
-    WriteTriple(os, s.vel_std_ned_mps);
+    AddTriple(line, s.v_n_mps);
+    AddTriple(line, s.vel_std_ned_mps);
   }
-  os << '\n';
+  line.Char('\n').WriteTo(file_.stream());
 }
 
 void KfginsGnssWriter::Commit() { file_.Commit(); }
@@ -260,12 +262,13 @@ void KfginsNavWriter::Write(const NavState& s) {
   RequireFinite(s.v_n_mps, "navigation velocity");
   RequireFinite(s.q_n_b.coeffs().head<3>(), "attitude quaternion");
   const Eigen::Vector3d euler_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
-  std::ostream& os = file_.stream();
-  os << (s.gps_week < 0 ? 0 : s.gps_week) << ' ' << s.t_s << ' ' << s.lat_rad * kRadToDeg << ' '
-     << s.lon_rad * kRadToDeg << ' ' << s.h_m;
-  WriteTriple(os, s.v_n_mps);
-  WriteTriple(os, euler_deg);
-  os << '\n';
+  TextLine line;
+  line.Integer(s.gps_week < 0 ? 0 : s.gps_week).Char(' ').Number(s.t_s).Char(' ');
+  line.Number(s.lat_rad * kRadToDeg).Char(' ').Number(s.lon_rad * kRadToDeg).Char(' ');
+  line.Number(s.h_m);
+  AddTriple(line, s.v_n_mps);
+  AddTriple(line, euler_deg);
+  line.Char('\n').WriteTo(file_.stream());
 }
 
 void KfginsNavWriter::Commit() { file_.Commit(); }

@@ -14,7 +14,11 @@ BodyKinematics BodyKinematicsAt(const TrajectoryPoint& p, double lat_rad, double
   const double sp = std::sin(e.y()), cp = std::cos(e.y());
   const Eigen::Vector3d omega_nb_b(de.x() - de.z() * sp, de.y() * cr + de.z() * sr * cp,
                                    -de.y() * sr + de.z() * cr * cp);
-  const Eigen::Matrix3d R_b_n = DcmFromEuler(e.x(), e.y(), e.z()).transpose();
+  const double sy = std::sin(e.z()), cy = std::cos(e.z());
+  Eigen::Matrix3d R_b_n;  // DcmFromEuler(e)^T, reusing the sines and cosines above
+  R_b_n << cy * cp, sy * cp, -sp,
+           cy * sp * sr - sy * cr, sy * sp * sr + cy * cr, cp * sr,
+           cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr;
   const Eigen::Vector3d w_ie = wgs84::EarthRateNed(lat_rad);
   const Eigen::Vector3d w_en = wgs84::TransportRateNed(lat_rad, h_m, p.v_n_mps);
   BodyKinematics k;

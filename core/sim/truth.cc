@@ -38,6 +38,11 @@ TruthGenerator::TruthGenerator(const AnalyticTrajectory& trajectory, const wgs84
     throw std::invalid_argument("TruthGenerator: rate_hz must be positive and finite");
   }
   current_ = Sample(0.0, position_);
+  // At the start, a one-sided difference over 1e-4 s (trajectories are defined for t >= 0).
+  constexpr double kDiffStep_s = 1e-4;
+  current_.alpha_ib_b_rad_s2 =
+      (BodyKinematicsAt(trajectory_, kDiffStep_s, start.lat_rad, start.h_m).omega_ib_b_rad_s -
+       current_.omega_ib_b_rad_s) / kDiffStep_s;
 }
 
 TruthSample TruthGenerator::Sample(double t, const wgs84::Geodetic& p) const {
@@ -54,13 +59,6 @@ TruthSample TruthGenerator::Sample(double t, const wgs84::Geodetic& p) const {
   const BodyKinematics k = BodyKinematicsAt(point, p.lat_rad, p.h_m);
   s.omega_ib_b_rad_s = k.omega_ib_b_rad_s;
   s.f_b_mps2 = k.f_b_mps2;
-  // Central difference; one-sided at the start (trajectories are defined for t >= 0).
-  constexpr double kDiffStep_s = 1e-4;
-  const double t_lo = std::max(0.0, t - kDiffStep_s), t_hi = t + kDiffStep_s;
-  s.alpha_ib_b_rad_s2 =
-      (BodyKinematicsAt(trajectory_, t_hi, p.lat_rad, p.h_m).omega_ib_b_rad_s -
-       BodyKinematicsAt(trajectory_, t_lo, p.lat_rad, p.h_m).omega_ib_b_rad_s) /
-      (t_hi - t_lo);
   s.a_n_mps2 = point.a_n_mps2;
   s.exact.t_s = t;
   return s;
@@ -78,6 +76,7 @@ const TruthSample& TruthGenerator::Next() {
   inc.t_s = t1;
   inc.dt_s = dt_s_;
   double t = t0;
+  Eigen::Vector3d omega_nodes[3];
   for (int i = 0; i < 3; ++i) {
     const double tn = t0 + nodes[i] * dt_s_;
     position_ = Rk4(trajectory_, position_, t, tn - t);
@@ -85,11 +84,18 @@ const TruthSample& TruthGenerator::Next() {
     const BodyKinematics kin = BodyKinematicsAt(trajectory_, tn, position_.lat_rad, position_.h_m);
     inc.dtheta_b_rad += weights[i] * dt_s_ * kin.omega_ib_b_rad_s;
     inc.dv_b_mps += weights[i] * dt_s_ * kin.f_b_mps2;
+    omega_nodes[i] = kin.omega_ib_b_rad_s;
   }
   position_ = Rk4(trajectory_, position_, t, t1 - t);
   ++k_;
   current_ = Sample(t1, position_);
   current_.exact = inc;
+  // Angular acceleration at t1: derivative of the quadratic through the angular rate at
+  // the last two nodes and at t1 (error O(dt^2 |d3 omega/dt3|)).
+  const double x0 = t0 + nodes[1] * dt_s_, x1 = t0 + nodes[2] * dt_s_, x2 = t1;
+  current_.alpha_ib_b_rad_s2 = omega_nodes[1] * ((x2 - x1) / ((x0 - x1) * (x0 - x2))) +
+                               omega_nodes[2] * ((x2 - x0) / ((x1 - x0) * (x1 - x2))) +
+                               current_.omega_ib_b_rad_s * ((2 * x2 - x0 - x1) / ((x2 - x0) * (x2 - x1)));
   return current_;
 }
 

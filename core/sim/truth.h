@@ -22,9 +22,10 @@ struct TruthSample {
 
 /// Walks a trajectory at a fixed rate from t = 0: the geodetic position by RK4 along the
 /// 3-point Gauss-Legendre nodes of each interval, the increments by the Gauss-Legendre
-/// rule (error O(dt^7)); the angular acceleration by a central difference of the angular
-/// rate over +-1e-4 s (error ~1e-8 |d3 omega/dt3|, far below any sensor model; one-sided
-/// over the first 1e-4 s).
+/// rule (error O(dt^7)); the angular acceleration as the derivative of the quadratic
+/// through the angular rate at the interval's last two nodes and its end (error
+/// O(dt^2 |d3 omega/dt3|): 0.02 % for +-30 deg wing rock at 0.5 Hz and 200 Hz), and by a
+/// one-sided 1e-4 s difference at t = 0.
 class TruthGenerator {
  public:
   TruthGenerator(const AnalyticTrajectory& trajectory, const wgs84::Geodetic& start, double rate_hz);
