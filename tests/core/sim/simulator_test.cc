@@ -84,13 +84,21 @@ RoundTrip MechanizeAgainstTruth(const std::string& dir, const Eigen::Vector3d& m
   return r;
 }
 
+// Presets short enough for a unit test (the 1 h one is run end to end in tests/apps).
+std::vector<std::string> ShortPresets() {
+  std::vector<std::string> names;
+  for (const std::string& name : PresetNames()) {
+    if (LoadScenario(name).duration_s <= 1200.0) names.push_back(name);
+  }
+  return names;
+}
+
 class PresetRoundTrip : public ::testing::TestWithParam<std::string> {};
 
 // The bound: error-free data reproduce the truth within 1 cm and 1e-4 deg (the
 // 1 h preset is checked end to end by the CLI test; here each preset's own length).
 TEST_P(PresetRoundTrip, PerfectSensorsReproduceTruth) {
   const Scenario scenario = LoadScenario(GetParam());
-  if (scenario.duration_s > 1200.0) GTEST_SKIP() << "long preset: covered by tests/apps";
   const std::string dir = MakeTempDir();
   SimulationOptions options;
   options.perfect = true;
@@ -104,12 +112,40 @@ TEST_P(PresetRoundTrip, PerfectSensorsReproduceTruth) {
   RemoveDir(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Presets, PresetRoundTrip, ::testing::ValuesIn(PresetNames()),
+INSTANTIATE_TEST_SUITE_P(Presets, PresetRoundTrip, ::testing::ValuesIn(ShortPresets()),
                          [](const auto& info) {
                            std::string name = info.param;
                            for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
                            return name;
                          });
+
+// The calibration rigs go through the same scenario path: a pendulum and a
+// multi-position table with a rate-table rotation, perfect sensors, reproduce their truth.
+TEST(Simulator, CalibrationRigScenariosRoundTrip) {
+  const std::string dir = MakeTempDir();
+  const std::string rigs[] = {
+      "name: pendulum\nduration_s: 30\nstart: {lat_deg: 37.45, lon_deg: 126.65, h_m: 20}\n"
+      "trajectory: {kind: pendulum, length_m: 0.8, damping_per_s: 0.05, initial_angle_deg: 40,"
+      " mounting: DNE}\nimu: {rate_hz: 200}\n",
+      "name: table\nduration_s: 60\nstart: {lat_deg: 37.45, lon_deg: 126.65, h_m: 20}\n"
+      "trajectory:\n  kind: multiposition\n  rotation_s: 4\n  dwell_s: 5\n  steps:\n"
+      "    - euler_deg: [0, 0, 0]\n    - euler_deg: [90, 0, 0]\n    - euler_deg: [0, 60, 0]\n"
+      "    - {rotate: yaw, rate_deg_s: 30, duration_s: 6, ramp_s: 1}\nimu: {rate_hz: 200}\n"};
+  for (const std::string& yaml : rigs) {
+    const Scenario scenario = ParseScenario(ParseYaml(yaml, "rig.yaml"));
+    SimulationOptions options;
+    options.perfect = true;
+    Simulate(scenario, options, dir);
+    const RoundTrip r = MechanizeAgainstTruth(dir, scenario.imu.mounting_rpy_rad, false);
+    EXPECT_EQ(r.epochs, static_cast<std::size_t>(scenario.duration_s * 200.0)) << scenario.name;
+    // The preset bound: 1 cm and 1e-4 deg.
+    EXPECT_LT(r.max_position_error_m, 0.01) << scenario.name;
+    EXPECT_LT(r.max_attitude_error_deg, 1e-4) << scenario.name;
+    const YAML::Node errors = YAML::LoadFile(dir + "/errors.yaml");
+    EXPECT_TRUE(errors["trajectory"]) << scenario.name << ": the rig's truth is not in errors.yaml";
+  }
+  RemoveDir(dir);
+}
 
 TEST(Simulator, SameSeedSameBytesOtherSeedOtherDraws) {
   Scenario scenario = LoadScenario("mems-gps-mag-maneuver");
