@@ -13,32 +13,6 @@
 namespace navtwin {
 namespace {
 
-/// A column found under one of its accepted names, with the factor to SI units.
-struct Column {
-  int index = -1;
-  double scale = 1.0;
-  std::string name;
-};
-
-struct UnitName {
-  const char* suffix;
-  double scale;
-};
-
-/// The column "<stem><suffix>" for the first suffix present; throws naming the first
-/// (SI) name and the alternatives when none is.
-Column RequireAny(const HeaderColumns& cols, const std::string& stem,
-                  std::initializer_list<UnitName> units, const std::string& path, long line) {
-  std::string tried;
-  for (const UnitName& u : units) {
-    const std::string name = stem + u.suffix;
-    const int i = cols.Find(name);
-    if (i >= 0) return Column{i, u.scale, name};
-    tried += tried.empty() ? "'" + name + "'" : " or '" + name + "'";
-  }
-  throw InputError(path, line, stem + units.begin()->suffix, "missing column " + tried);
-}
-
 class CsvImuReader final : public ImuReader {
  public:
   explicit CsvImuReader(const std::string& path) : lines_(path) { ReadHeader(); }
@@ -81,8 +55,7 @@ class CsvImuReader final : public ImuReader {
   }
 
   void LocateColumns() {
-    const long line = lines_.line_number();
-    time_ = RequireAny(header_, "t", {{"_s", 1.0}, {"_ms", 1e-3}}, path(), line);
+    time_ = header_.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
     rates_ = header_.Find("dtheta_x_rad") < 0 &&
              (header_.Find("gyro_x_rad_s") >= 0 || header_.Find("gyro_x_dps") >= 0);
     const char* axes[3] = {"x", "y", "z"};
@@ -90,12 +63,12 @@ class CsvImuReader final : public ImuReader {
       const std::string a = axes[k];
       if (rates_) {
         columns_[k] =
-            RequireAny(header_, "gyro_" + a, {{"_rad_s", 1.0}, {"_dps", kDegToRad}}, path(), line);
-        columns_[3 + k] = RequireAny(header_, "acc_" + a,
-                                     {{"_mps2", 1.0}, {"_g", kStandardGravity_mps2}}, path(), line);
+            header_.RequireWithUnit("gyro_" + a, {{"_rad_s", 1.0}, {"_dps", kDegToRad}});
+        columns_[3 + k] =
+            header_.RequireWithUnit("acc_" + a, {{"_mps2", 1.0}, {"_g", kStandardGravity_mps2}});
       } else {
-        columns_[k] = RequireAny(header_, "dtheta_" + a, {{"_rad", 1.0}}, path(), line);
-        columns_[3 + k] = RequireAny(header_, "dv_" + a, {{"_mps", 1.0}}, path(), line);
+        columns_[k] = header_.RequireWithUnit("dtheta_" + a, {{"_rad", 1.0}});
+        columns_[3 + k] = header_.RequireWithUnit("dv_" + a, {{"_mps", 1.0}});
       }
     }
   }
@@ -113,7 +86,7 @@ class CsvImuReader final : public ImuReader {
     return false;
   }
 
-  double Value(const Column& c) const {
+  double Value(const UnitColumn& c) const {
     return ParseDouble(fields_[static_cast<std::size_t>(c.index)], path(), lines_.line_number(),
                        c.name) *
            c.scale;
@@ -125,8 +98,8 @@ class CsvImuReader final : public ImuReader {
 
   LineReader lines_;
   HeaderColumns header_;
-  Column time_;
-  Column columns_[6];  ///< gyro or dtheta x y z, then acc or dv x y z
+  UnitColumn time_;
+  UnitColumn columns_[6];  ///< gyro or dtheta x y z, then acc or dv x y z
   bool rates_ = false;
   std::string line_;
   std::vector<std::string_view> fields_;

@@ -16,39 +16,6 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kAbsoluteZero_degC = -273.15;
 
-/// A column found under one of its accepted names, with the factor to the SI unit.
-struct Column {
-  int index = -1;
-  double scale = 1.0;
-  std::string name;
-};
-
-struct UnitName {
-  const char* suffix;
-  double scale;
-};
-
-/// The column "<stem><suffix>" for the first suffix present, or index -1.
-Column FindAny(const HeaderColumns& cols, const std::string& stem,
-               std::initializer_list<UnitName> units) {
-  for (const UnitName& u : units) {
-    const std::string name = stem + u.suffix;
-    const int i = cols.Find(name);
-    if (i >= 0) return Column{i, u.scale, name};
-  }
-  return Column{-1, 1.0, stem + units.begin()->suffix};
-}
-
-/// Like FindAny, but throws InputError naming every accepted name when none is present.
-Column RequireAny(const HeaderColumns& cols, const std::string& stem,
-                  std::initializer_list<UnitName> units, const std::string& path, long line) {
-  const Column c = FindAny(cols, stem, units);
-  if (c.index >= 0) return c;
-  std::string tried;
-  for (const UnitName& u : units) tried += (tried.empty() ? "'" : " or '") + stem + u.suffix + "'";
-  throw InputError(path, line, c.name, "missing column " + tried);
-}
-
 /// The rows of a headed CSV file: header found, field count and time checked per row.
 class CsvTable {
  public:
@@ -58,7 +25,7 @@ class CsvTable {
       SplitCsv(line_, &fields_);
       header_ = HeaderColumns(fields_, path, lines_.line_number());
       header_line_ = lines_.line_number();
-      time_ = RequireAny(header_, "t", {{"_s", 1.0}, {"_ms", 1e-3}}, path, header_line_);
+      time_ = header_.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
       return;
     }
     throw InputError(path, 0, "", "no samples (the file is empty)");
@@ -80,11 +47,11 @@ class CsvTable {
   }
 
   /// The number in column c times its unit factor.
-  double Value(const Column& c) const {
+  double Value(const UnitColumn& c) const {
     return ParseDouble(Field(c), path(), line(), c.name) * c.scale;
   }
   /// Like Value, but NaN for an absent column or an empty field.
-  double OptionalValue(const Column& c) const {
+  double OptionalValue(const UnitColumn& c) const {
     if (c.index < 0 || Field(c).empty()) return kNaN;
     return Value(c);
   }
@@ -96,14 +63,14 @@ class CsvTable {
   const std::string& path() const { return lines_.path(); }
 
  private:
-  std::string_view Field(const Column& c) const {
+  std::string_view Field(const UnitColumn& c) const {
     return fields_[static_cast<std::size_t>(c.index)];
   }
 
   LineReader lines_;
   HeaderColumns header_;
   long header_line_ = 0;
-  Column time_;
+  UnitColumn time_;
   std::string line_;
   std::vector<std::string_view> fields_;
   double time_s_ = 0.0;
@@ -117,10 +84,8 @@ class CsvMagReader final : public MagReader {
     constexpr double kGauss_uT = 100.0, kNano_uT = 1e-3;
     const char* axes[3] = {"mx", "my", "mz"};
     for (int k = 0; k < 3; ++k) {
-      axes_[k] =
-          RequireAny(table_.header(), axes[k],
-                     {{"_uT", 1.0}, {"_G", kGauss_uT}, {"_ga", kGauss_uT}, {"_nT", kNano_uT}}, path,
-                     table_.header_line());
+      axes_[k] = table_.header().RequireWithUnit(
+          axes[k], {{"_uT", 1.0}, {"_G", kGauss_uT}, {"_ga", kGauss_uT}, {"_nT", kNano_uT}});
     }
   }
 
@@ -134,15 +99,15 @@ class CsvMagReader final : public MagReader {
 
  private:
   CsvTable table_;
-  Column axes_[3];
+  UnitColumn axes_[3];
 };
 
 class CsvBaroReader final : public BaroReader {
  public:
   explicit CsvBaroReader(const std::string& path) : table_(path) {
-    pressure_ = FindAny(table_.header(), "pressure", {{"_pa", 1.0}});
-    altitude_ = FindAny(table_.header(), "altitude", {{"_m", 1.0}});
-    temperature_ = FindAny(table_.header(), "temperature", {{"_degC", 1.0}});
+    pressure_ = table_.header().FindWithUnit("pressure", {{"_pa", 1.0}});
+    altitude_ = table_.header().FindWithUnit("altitude", {{"_m", 1.0}});
+    temperature_ = table_.header().FindWithUnit("temperature", {{"_degC", 1.0}});
     if (pressure_.index < 0 && altitude_.index < 0) {
       throw InputError(path, table_.header_line(), "pressure_pa",
                        "missing column 'pressure_pa' or 'altitude_m'");
@@ -172,7 +137,7 @@ class CsvBaroReader final : public BaroReader {
 
  private:
   CsvTable table_;
-  Column pressure_, altitude_, temperature_;
+  UnitColumn pressure_, altitude_, temperature_;
 };
 
 /// A value, or nothing for NaN (an absent barometer quantity).

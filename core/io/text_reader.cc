@@ -197,4 +197,23 @@ int HeaderColumns::Require(const std::string& name) const {
   return i;
 }
 
+UnitColumn HeaderColumns::FindWithUnit(const std::string& stem,
+                                       std::initializer_list<UnitSuffix> units) const {
+  for (const UnitSuffix& u : units) {
+    const std::string name = stem + u.suffix;
+    const int i = Find(name);
+    if (i >= 0) return UnitColumn{i, u.scale, name};
+  }
+  return UnitColumn{-1, 1.0, stem + units.begin()->suffix};
+}
+
+UnitColumn HeaderColumns::RequireWithUnit(const std::string& stem,
+                                          std::initializer_list<UnitSuffix> units) const {
+  const UnitColumn c = FindWithUnit(stem, units);
+  if (c.index >= 0) return c;
+  std::string tried;
+  for (const UnitSuffix& u : units) tried += (tried.empty() ? "'" : " or '") + stem + u.suffix + "'";
+  throw InputError(path_, line_, c.name, "missing column " + tried);
+}
+
 }  // namespace navtwin

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -84,6 +85,19 @@ class IncreasingTime {
 };
 
 /// Column names of a CSV header line, looked up by name.
+/// A unit suffix a column name may carry and its factor to the SI unit, e.g. {"_dps", deg->rad}.
+struct UnitSuffix {
+  const char* suffix;
+  double scale;
+};
+
+/// A column found under one of its accepted names, with the factor to the SI unit.
+struct UnitColumn {
+  int index = -1;  ///< -1: absent
+  double scale = 1.0;
+  std::string name;
+};
+
 class HeaderColumns {
  public:
   HeaderColumns() = default;
@@ -93,6 +107,11 @@ class HeaderColumns {
   int Find(std::string_view name) const;
   /// Like Find, but throws InputError "missing column 'name'" when absent.
   int Require(const std::string& name) const;
+  /// The column "<stem><suffix>" for the first of `units` present, or index -1 (named by the
+  /// first, SI, suffix).
+  UnitColumn FindWithUnit(const std::string& stem, std::initializer_list<UnitSuffix> units) const;
+  /// Like FindWithUnit, but throws InputError naming every accepted name when none is present.
+  UnitColumn RequireWithUnit(const std::string& stem, std::initializer_list<UnitSuffix> units) const;
   std::size_t size() const { return names_.size(); }
   const std::vector<std::string>& names() const { return names_; }
 

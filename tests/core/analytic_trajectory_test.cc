@@ -4,6 +4,7 @@
 
 #include "core/rotation.h"
 #include "core/strapdown.h"
+#include "tests/core/sim/round_trip.h"
 
 namespace navtwin::sim {
 namespace {
@@ -12,33 +13,14 @@ namespace {
 // this checks the synthesis and the strapdown against each other over 1 h of manoeuvres
 // at 200 Hz (the simulator issue's round-trip case).
 TEST(AnalyticTrajectory, MechanizationReproducesOneHourDemoFlight) {
-  DemoFlight flight;
-  std::unique_ptr<Strapdown> ins;
-  NavState truth_end;
-  double max_pos_err_m = 0.0, max_att_err_rad = 0.0;
-  SynthesizeImu(flight, {37.5 * kDegToRad, 127.0 * kDegToRad, 500.0}, 200.0, 3600.0,
-                [&](const ImuSample& imu, const NavState& truth) {
-                  if (!ins) {
-                    ins = std::make_unique<Strapdown>(truth);
-                    return;
-                  }
-                  ins->Update(imu);
-                  const NavState& s = ins->state();
-                  max_pos_err_m = std::max(
-                      max_pos_err_m,
-                      wgs84::GeodeticToNed({s.lat_rad, s.lon_rad, s.h_m},
-                                           {truth.lat_rad, truth.lon_rad, truth.h_m})
-                          .norm());
-                  max_att_err_rad =
-                      std::max(max_att_err_rad, AttitudeError(truth.q_n_b, s.q_n_b).norm());
-                  truth_end = truth;
-                });
-  EXPECT_NEAR(truth_end.t_s, 3600.0, 1e-9);
+  const testing::SynthesisRoundTrip r = testing::MechanizeExactIncrements(
+      DemoFlight(), {37.5 * kDegToRad, 127.0 * kDegToRad, 500.0}, 200.0, 3600.0);
+  EXPECT_NEAR(r.t_end_s, 3600.0, 1e-9);
   // The bounds are 1 cm and 1e-4 deg; measured 18 um and 3e-10 deg (see
   // docs/strapdown.md). 1 mm and 1e-8 deg keep a 50x margin and still catch the loss of
   // the second-order rotation compensation (0.8 m) or of coning/sculling.
-  EXPECT_LT(max_pos_err_m, 1e-3);
-  EXPECT_LT(max_att_err_rad * kRadToDeg, 1e-8);
+  EXPECT_LT(r.max_position_m, 1e-3);
+  EXPECT_LT(r.max_attitude_deg, 1e-8);
 }
 
 TEST(AnalyticTrajectory, SpecificForceAtRestIsMinusGravity) {

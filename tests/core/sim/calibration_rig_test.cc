@@ -2,6 +2,7 @@
 // pendulum's angle against its ODE and the small-angle solution, the seed's mountings,
 // derivative consistency, and the exact-increment round trip through the strapdown.
 #include "core/sim/calibration_rig.h"
+#include "tests/core/sim/round_trip.h"
 
 #include <algorithm>
 #include <cmath>
@@ -84,24 +85,8 @@ struct RoundTrip {
 
 /// The strapdown on the exact increments at 200 Hz against the truth: largest errors.
 RoundTrip Mechanize(const AnalyticTrajectory& tr, double duration_s) {
-  std::unique_ptr<Strapdown> ins;
-  RoundTrip r;
-  SynthesizeImu(tr, kLab, 200.0, duration_s, [&](const ImuSample& imu, const NavState& truth) {
-    if (!ins) {
-      ins = std::make_unique<Strapdown>(truth);
-      return;
-    }
-    ins->Update(imu);
-    const NavState& s = ins->state();
-    r.attitude_deg =
-        std::max(r.attitude_deg, AttitudeError(truth.q_n_b, s.q_n_b).norm() * kRadToDeg);
-    r.position_m =
-        std::max(r.position_m, wgs84::GeodeticToNed({s.lat_rad, s.lon_rad, s.h_m},
-                                                    {truth.lat_rad, truth.lon_rad, truth.h_m})
-                                   .norm());
-    r.velocity_mps = std::max(r.velocity_mps, (s.v_n_mps - truth.v_n_mps).norm());
-  });
-  return r;
+  const testing::SynthesisRoundTrip m = testing::MechanizeExactIncrements(tr, kLab, 200.0, duration_s);
+  return {m.max_attitude_deg, m.max_position_m, m.max_velocity_mps};
 }
 
 // ------------------------------------------------------------- multi-position table

@@ -1,4 +1,5 @@
 #include "core/sim/segments.h"
+#include "tests/core/sim/round_trip.h"
 
 #include <algorithm>
 #include <cmath>
@@ -226,31 +227,13 @@ TEST(SegmentTrajectory, ManySegmentsAreEvaluatedInTheirOwnSegment) {
 
 TEST(SegmentTrajectory, MechanizationReproducesTheTruthOnEveryKind) {
   const SegmentTrajectory traj(Parse(kEveryKind));
-  std::unique_ptr<Strapdown> ins;
-  NavState truth_end;
-  double max_pos_err_m = 0.0, max_att_err_rad = 0.0;
-  SynthesizeImu(traj, {45.0 * kDegToRad, 7.0 * kDegToRad, 300.0}, 200.0, traj.duration_s(),
-                [&](const ImuSample& imu, const NavState& truth) {
-                  if (!ins) {
-                    ins = std::make_unique<Strapdown>(truth);
-                    return;
-                  }
-                  ins->Update(imu);
-                  const NavState& s = ins->state();
-                  max_pos_err_m = std::max(
-                      max_pos_err_m,
-                      wgs84::GeodeticToNed({s.lat_rad, s.lon_rad, s.h_m},
-                                           {truth.lat_rad, truth.lon_rad, truth.h_m})
-                          .norm());
-                  max_att_err_rad =
-                      std::max(max_att_err_rad, AttitudeError(truth.q_n_b, s.q_n_b).norm());
-                  truth_end = truth;
-                });
-  EXPECT_NEAR(truth_end.t_s, 590.0, 1e-9);
+  const testing::SynthesisRoundTrip r = testing::MechanizeExactIncrements(
+      traj, {45.0 * kDegToRad, 7.0 * kDegToRad, 300.0}, 200.0, traj.duration_s());
+  EXPECT_NEAR(r.t_end_s, 590.0, 1e-9);
   // The bounds: 1 cm and 1e-4 deg; measured 38 um and 5e-8 deg. An attitude or
   // velocity inconsistent with its analytic derivative drifts far beyond them.
-  EXPECT_LT(max_pos_err_m, 0.01);
-  EXPECT_LT(max_att_err_rad * kRadToDeg, 1e-4);
+  EXPECT_LT(r.max_position_m, 0.01);
+  EXPECT_LT(r.max_attitude_deg, 1e-4);
 }
 
 // A configuration error's field and line.
