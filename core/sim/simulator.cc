@@ -27,6 +27,17 @@ NavState InitialState(const NavState& truth, const InitErrorConfig& e) {
   return s;
 }
 
+/// Feeds one truth sample to an aiding simulator (if the scenario has it) and writes the
+/// sample it emits, if any.
+template <typename Simulator, typename Writer>
+void PushAndWrite(Simulator* simulator, Writer* writer, const TruthSample& truth, std::size_t* count) {
+  if (simulator == nullptr) return;
+  if (const auto sample = simulator->Push(truth)) {
+    writer->Write(*sample);
+    ++*count;
+  }
+}
+
 void EmitVector(YAML::Emitter& out, const char* key, const Eigen::Vector3d& v) {
   out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << v.z()
       << YAML::EndSeq;
@@ -89,30 +100,10 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
       truth_out.Write(t.state);
       ++report.imu_samples;
     }
-    if (gnss) {
-      if (const auto s = gnss->Push(t)) {
-        gnss_out->Write(*s);
-        ++report.gnss_samples;
-      }
-    }
-    if (mag) {
-      if (const auto s = mag->Push(t)) {
-        mag_out->Write(*s);
-        ++report.mag_samples;
-      }
-    }
-    if (baro) {
-      if (const auto s = baro->Push(t)) {
-        baro_out->Write(*s);
-        ++report.baro_samples;
-      }
-    }
-    if (master) {
-      if (const auto s = master->Push(t)) {
-        master_out->Write(*s);
-        ++report.master_samples;
-      }
-    }
+    PushAndWrite(gnss.get(), gnss_out.get(), t, &report.gnss_samples);
+    PushAndWrite(mag.get(), mag_out.get(), t, &report.mag_samples);
+    PushAndWrite(baro.get(), baro_out.get(), t, &report.baro_samples);
+    PushAndWrite(master.get(), master_out.get(), t, &report.master_samples);
     if (options.progress && k % progress_step == 0) options.progress(static_cast<double>(k) / n);
   }
 
