@@ -158,21 +158,6 @@ double Rate(const ConfigNode& node, double fallback, double hi) {
 
 // ------------------------------------------------------------------ errors.yaml
 
-void EmitVector(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v,
-                double per_unit) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (int i = 0; i < 3; ++i) out << v[i] / per_unit;
-  out << YAML::EndSeq;
-}
-
-void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3d& m) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (int r = 0; r < 3; ++r) {
-    out << YAML::BeginSeq << m(r, 0) << m(r, 1) << m(r, 2) << YAML::EndSeq;
-  }
-  out << YAML::EndSeq;
-}
-
 void EmitValue(YAML::Emitter& out, const std::string& key, double value) {
   out << YAML::Key << key << YAML::Value << value;
 }
@@ -384,9 +369,9 @@ void GnssSimulator::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::BeginMap;
   out << YAML::Key << "perfect" << YAML::Value << perfect_;
   EmitValue(out, "rate_hz", config_.rate_hz);
-  EmitVector(out, "position_sigma_ned_m", config_.position_sigma_ned_m, 1.0);
-  EmitVector(out, "velocity_sigma_ned_mps", config_.velocity_sigma_ned_mps, 1.0);
-  EmitVector(out, "lever_arm_b_m", config_.lever_arm_b_m, 1.0);
+  EmitVector(out, "position_sigma_ned_m", config_.position_sigma_ned_m);
+  EmitVector(out, "velocity_sigma_ned_mps", config_.velocity_sigma_ned_mps);
+  EmitVector(out, "lever_arm_b_m", config_.lever_arm_b_m);
   EmitValue(out, "time_offset_s", config_.time_offset_s);
   EmitValue(out, "start_s", config_.start_s);
   out << YAML::Key << "outages_s" << YAML::Value << YAML::Flow << YAML::BeginSeq;
@@ -400,7 +385,7 @@ void GnssSimulator::EmitDrawn(YAML::Emitter& out) const {
   for (const GnssOutlier& o : outliers_) {
     out << YAML::Flow << YAML::BeginMap;
     EmitValue(out, "t_s", o.t_s);
-    EmitVector(out, "offset_ned_m", o.offset_ned_m, 1.0);
+    EmitVector(out, "offset_ned_m", o.offset_ned_m);
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;

@@ -158,12 +158,6 @@ PendulumConfig ParsePendulum(const ConfigNode& node) {
 
 // -------------------------------------------------------------------- output
 
-void EmitVector(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v,
-                double scale) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() * scale
-      << v.y() * scale << v.z() * scale << YAML::EndSeq;
-}
-
 }  // namespace
 
 CalibrationRigConfig ParseCalibrationRigConfig(const ConfigNode& node) {
@@ -278,7 +272,7 @@ void MultiPositionRig::EmitDrawn(YAML::Emitter& out) const {
     out << YAML::Flow << YAML::BeginMap;
     out << YAML::Key << "start_s" << YAML::Value << s.start_s;
     out << YAML::Key << "end_s" << YAML::Value << s.end_s;
-    EmitVector(out, "euler_deg", s.euler_rad, kRadToDeg);
+    EmitVector(out, "euler_deg", s.euler_rad, kDegToRad);
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;
@@ -421,13 +415,8 @@ void PendulumRig::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::Key << "c2_per_s2" << YAML::Value << c2_;
   out << YAML::Key << "initial_angle_deg" << YAML::Value << config_.initial_angle_rad * kRadToDeg;
   out << YAML::Key << "initial_rate_deg_s" << YAML::Value << config_.initial_rate_rad_s * kRadToDeg;
-  out << YAML::Key << "mounting_p_b" << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (int r = 0; r < 3; ++r) {
-    const Eigen::Matrix3d& R = config_.mounting_p_b;
-    out << YAML::BeginSeq << R(r, 0) << R(r, 1) << R(r, 2) << YAML::EndSeq;
-  }
-  out << YAML::EndSeq;
-  EmitVector(out, "pivot_axis_b", pivot_axis_b_, 1.0);
+  EmitMatrix(out, "mounting_p_b", config_.mounting_p_b);
+  EmitVector(out, "pivot_axis_b", pivot_axis_b_);
   out << YAML::EndMap;
 }
 

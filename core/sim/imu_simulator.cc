@@ -96,12 +96,8 @@ std::optional<ImuSample> ImuSimulator::Push(const TruthSample& truth) {
 void ImuSimulator::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::BeginMap;
   out << YAML::Key << "rate_hz" << YAML::Value << config_.rate_hz;
-  const Eigen::Vector3d m = config_.mounting_rpy_rad * kRadToDeg;
-  out << YAML::Key << "mounting_deg" << YAML::Value << YAML::Flow << YAML::BeginSeq << m.x()
-      << m.y() << m.z() << YAML::EndSeq;
-  const Eigen::Vector3d& l = config_.lever_arm_b_m;
-  out << YAML::Key << "lever_arm_b_m" << YAML::Value << YAML::Flow << YAML::BeginSeq << l.x()
-      << l.y() << l.z() << YAML::EndSeq;
+  EmitVector(out, "mounting_deg", config_.mounting_rpy_rad, kDegToRad);
+  EmitVector(out, "lever_arm_b_m", config_.lever_arm_b_m);
   out << YAML::Key << "delay_s" << YAML::Value << config_.delay_s;
   out << YAML::Key << "clock_offset_s" << YAML::Value << config_.clock_offset_s;
   out << YAML::Key << "oversample" << YAML::Value << config_.anti_alias.oversample;

@@ -174,22 +174,6 @@ double GaussMarkovIntegralShape(double x) {
 
 // ---------------------------------------------------------------- errors.yaml
 
-void EmitVector(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v, double per_unit) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (int i = 0; i < 3; ++i) out << v[i] / per_unit;
-  out << YAML::EndSeq;
-}
-
-void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3d& m, double per_unit) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (int r = 0; r < 3; ++r) {
-    out << YAML::BeginSeq;
-    for (int c = 0; c < 3; ++c) out << m(r, c) / per_unit;
-    out << YAML::EndSeq;
-  }
-  out << YAML::EndSeq;
-}
-
 void EmitTriad(YAML::Emitter& out, const TriadErrorModel& model, const TriadUnits& u) {
   const TriadErrorConfig& c = model.config();
   const DrawnTriadErrors& d = model.drawn();

@@ -38,11 +38,6 @@ void PushAndWrite(Simulator* simulator, Writer* writer, const TruthSample& truth
   }
 }
 
-void EmitVector(YAML::Emitter& out, const char* key, const Eigen::Vector3d& v) {
-  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << v.z()
-      << YAML::EndSeq;
-}
-
 }  // namespace
 
 SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& options,
@@ -140,7 +135,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
   y << YAML::Key << "init_errors" << YAML::Value << YAML::BeginMap;
   EmitVector(y, "position_ned_m", scenario.init_errors.position_ned_m);
   EmitVector(y, "velocity_ned_mps", scenario.init_errors.velocity_ned_mps);
-  EmitVector(y, "attitude_phi_n_deg", scenario.init_errors.attitude_phi_n_rad * kRadToDeg);
+  EmitVector(y, "attitude_phi_n_deg", scenario.init_errors.attitude_phi_n_rad, kDegToRad);
   y << YAML::EndMap << YAML::EndMap;
   errors.stream() << y.c_str() << "\n";
 

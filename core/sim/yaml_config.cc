@@ -146,6 +146,24 @@ Eigen::Vector2d ConfigNode::Range(const std::string& key, const Eigen::Vector2d&
   return v;
 }
 
+void EmitVector(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v_si,
+                double per_unit) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < 3; ++i) out << v_si[i] / per_unit;
+  out << YAML::EndSeq;
+}
+
+void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3d& m_si,
+                double per_unit) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (int r = 0; r < 3; ++r) {
+    out << YAML::BeginSeq;
+    for (int c = 0; c < 3; ++c) out << m_si(r, c) / per_unit;
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndSeq;
+}
+
 ConfigNode ParseYaml(const std::string& text, const std::string& file) {
   try {
     return ConfigNode(YAML::Load(text), file, "");

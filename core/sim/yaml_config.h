@@ -54,6 +54,14 @@ class ConfigNode {
   std::string path_;
 };
 
+/// errors.yaml output: `key: [x, y, z]` / `key: [[..], [..], [..]]` with each SI value
+/// divided by `per_unit`, the SI size of the unit named in the key (e.g. kDegToRad for a
+/// key ending in _deg).
+void EmitVector(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v_si,
+                double per_unit = 1.0);
+void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3d& m_si,
+                double per_unit = 1.0);
+
 /// Parses YAML text (from a file or a built-in preset named `file`) into a root node;
 /// syntax errors become InputError with the line.
 ConfigNode ParseYaml(const std::string& text, const std::string& file);
