@@ -50,11 +50,7 @@ Scenario ParseScenario(const ConfigNode& root) {
     s.emit_trajectory = [rig](YAML::Emitter& out) { rig->EmitDrawn(out); };
     s.trajectory = rig;
   } else if (kind == "segments") {
-    // The segment parser knows no `kind` key: hand it the mapping without it.
-    YAML::Node without_kind = YAML::Clone(trajectory.yaml());
-    if (without_kind.IsMap()) without_kind.remove("kind");
-    auto segments = std::make_shared<SegmentTrajectory>(ParseTrajectoryConfig(
-        ConfigNode(without_kind, trajectory.file(), trajectory.path())));
+    auto segments = std::make_shared<SegmentTrajectory>(ParseTrajectoryConfig(trajectory));
     trajectory_duration_s = segments->duration_s();
     s.trajectory = segments;
   } else {

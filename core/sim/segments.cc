@@ -440,7 +440,8 @@ SegmentConfig ParseSegment(const ConfigNode& n) {
 }  // namespace
 
 TrajectoryConfig ParseTrajectoryConfig(const ConfigNode& node) {
-  node.RequireKeys({"initial", "transition_s", "segments"});
+  node.RequireKeys({"kind", "initial", "transition_s", "segments"});
+  if (node.String("kind", "segments") != "segments") node.Fail("kind", "expected segments");
   const ConfigNode initial = node.Child("initial");
   initial.RequireKeys({"speed_mps", "heading_deg", "flight_path_deg", "roll_offset_deg",
                        "pitch_offset_deg", "yaw_offset_deg"});
