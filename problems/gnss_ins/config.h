@@ -1,0 +1,173 @@
+// Configuration of the GNSS/INS/magnetometer estimators (filter, RTS, batch). SI units
+// and radians inside; the YAML file says its units in its keys (docs/gnss-ins.md lists
+// every key), and a KF-GINS configuration is accepted unchanged (ParseKfginsConfig).
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "core/types.h"
+
+namespace navtwin::gnss_ins {
+
+/// IMU noise and error-process parameters. Biases and scale factors are first-order
+/// Gauss-Markov processes with steady-state standard deviation *_std and correlation time
+/// correlation_time_s (infinite: random constants driven by no noise).
+struct ImuNoise {
+  double gyro_arw_rad_per_sqrt_s = 0.0;
+  double accel_vrw_mps_per_sqrt_s = 0.0;
+  double gyro_bias_std_radps = 0.0;
+  double accel_bias_std_mps2 = 0.0;
+  double gyro_scale_std = 0.0;   ///< dimensionless (ppm * 1e-6)
+  double accel_scale_std = 0.0;
+  double correlation_time_s = 3600.0;
+};
+
+/// 1-sigma uncertainty of the initial state (error-state layout of ins_state.h).
+struct InitialStd {
+  Eigen::Vector3d pos_ned_m = Eigen::Vector3d::Constant(10.0);
+  Eigen::Vector3d vel_ned_mps = Eigen::Vector3d::Constant(1.0);
+  Eigen::Vector3d att_rad = Eigen::Vector3d::Constant(0.1);
+  Eigen::Vector3d bg_radps = Eigen::Vector3d::Zero();  ///< zero: take ImuNoise::gyro_bias_std
+  Eigen::Vector3d ba_mps2 = Eigen::Vector3d::Zero();   ///< zero: take ImuNoise::accel_bias_std
+  Eigen::Vector3d sg = Eigen::Vector3d::Zero();        ///< zero: take ImuNoise::gyro_scale_std
+  Eigen::Vector3d sa = Eigen::Vector3d::Zero();        ///< zero: take ImuNoise::accel_scale_std
+};
+
+/// How the IMU is installed.
+struct Installation {
+  /// Roll, pitch, yaw (ZYX) of the IMU axes relative to the body FRD axes:
+  /// v_b = DcmFromEuler(r, p, y) * v_imu.
+  Eigen::Vector3d imu_mounting_rpy_rad = Eigen::Vector3d::Zero();
+  /// Added to the IMU time tags to put them on the GNSS time scale.
+  double imu_time_offset_s = 0.0;
+  /// GNSS antenna phase centre from the IMU, body FRD axes.
+  Eigen::Vector3d antenna_lever_arm_b_m = Eigen::Vector3d::Zero();
+};
+
+/// Initial state: given (a KF-GINS initpos/initvel/initatt, or an init nav file), or from
+/// an alignment.
+struct InitConfig {
+  enum class Source {
+    kGiven,            ///< `state` below
+    kStaticAlignment,  ///< coarse alignment (gravity + Earth rate, or + magnetometer heading)
+                       ///< over the first static_duration_s; position from the first GNSS fix
+    kGnssVelocity,     ///< level attitude, heading from the GNSS velocity once the speed
+                       ///< exceeds min_speed_mps; position and velocity from GNSS
+  };
+  Source source = Source::kGiven;
+  std::optional<InsState> state;  ///< required for kGiven (time = start)
+  double static_duration_s = 60.0;
+  double min_speed_mps = 5.0;
+  ImuErrors imu_errors;           ///< initial IMU error estimates (KF-GINS initgyrbias, ...)
+  InitialStd std;
+};
+
+/// Magnetometer use. Calibration (hard iron h, soft iron S) follows the simulator's model
+/// m_b = (I + S) R_b_n m_n + h; measurements are corrected as (I + S)^-1 (m - h).
+struct MagConfig {
+  enum class Mode {
+    kOff,
+    kVector,        ///< full field vector in the body axes (needs field_ned_uT)
+    kHeading,       ///< 3-axis tilt-compensated heading
+    kHeading2Axis,  ///< seed 001: heading from x, y only, used while |roll|, |pitch| < max_tilt_rad
+  };
+  Mode mode = Mode::kOff;
+  Eigen::Vector3d field_ned_uT = Eigen::Vector3d::Zero();  ///< for kVector
+  double declination_rad = 0.0;                            ///< east of true north
+  Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d soft_iron = Eigen::Matrix3d::Zero();
+  double noise_uT = 0.5;            ///< per axis, kVector
+  double heading_std_rad = 0.035;   ///< kHeading, kHeading2Axis
+  double max_tilt_rad = 2.0 * 3.14159265358979323846 / 180.0;
+  double min_interval_s = 0.0;      ///< use at most one sample per this interval (0: all)
+};
+
+struct BaroConfig {
+  bool use = false;
+  double std_m = 1.0;
+  /// The barometer's offset from the ellipsoidal height is taken at the first GNSS epoch
+  /// (or the initial state) and held constant.
+};
+
+struct ZuptConfig {
+  bool enabled = false;
+  double std_mps = 0.02;
+  double window_s = 0.5;                 ///< detection window
+  double gyro_threshold_radps = 0.01;    ///< max |omega| over the window
+  double accel_std_threshold_mps2 = 0.05;///< max std of |f| over the window
+  double interval_s = 0.1;               ///< at most one update per this interval
+};
+
+struct GnssConfig {
+  bool use_velocity = true;        ///< when the file has velocity
+  double pos_std_floor_m = 0.0;    ///< sigma used = max(file sigma, floor)
+  double vel_std_floor_mps = 0.0;
+  double default_pos_std_m = 5.0;  ///< when the file gives none
+  double default_vel_std_mps = 0.1;
+  double max_distance_m = 10000.0; ///< a fix this far from the INS prediction is an input error
+};
+
+/// Injected GNSS outages for scoring: no GNSS in [start + k period, start + k period + len).
+struct OutageConfig {
+  double start_s = std::numeric_limits<double>::quiet_NaN();  ///< NaN: none (relative to the
+                                                              ///< first IMU time)
+  double len_s = 0.0;
+  double period_s = 0.0;  ///< 0: a single outage
+};
+
+struct FilterConfig {
+  bool scale_factors = false;          ///< 21 states instead of 15
+  double gate_probability = 0.9999;    ///< chi-square gate on each innovation (1: no gating)
+  double store_interval_s = 1.0;       ///< RTS knots: every update and at least this often
+  double max_bridge_gap_s = 0.1;       ///< IMU gaps up to this are bridged, longer stop the run
+  /// The covariance is propagated over groups of IMU samples at most this long (the
+  /// nominal state at every sample); 0: at every sample.
+  double covariance_interval_s = 0.02;
+};
+
+struct BatchConfig {
+  double state_interval_s = 0.0;   ///< 0: a state at every GNSS epoch (and every max_state_interval_s)
+  double max_state_interval_s = 1.0;
+  double huber_k = 3.0;            ///< Huber threshold on GNSS residuals, in sigmas (0: plain)
+  int max_iterations = 50;
+  int threads = 1;
+  bool covariance = true;          ///< per-state standard deviations from ceres::Covariance
+  double relinearize_bias_radps = 0.0;  ///< re-preintegrate when a gyro bias moves more (0: auto)
+};
+
+struct GnssInsConfig {
+  ImuNoise imu_noise;
+  Installation installation;
+  InitConfig init;
+  MagConfig mag;
+  BaroConfig baro;
+  ZuptConfig zupt;
+  GnssConfig gnss;
+  OutageConfig outages;
+  FilterConfig filter;
+  BatchConfig batch;
+  double start_time_s = -std::numeric_limits<double>::infinity();
+  double end_time_s = std::numeric_limits<double>::infinity();
+  double output_rate_hz = 0.0;  ///< 0: every IMU epoch
+  /// KF-GINS paths when the configuration came from a KF-GINS file (empty otherwise).
+  std::string imu_path, gnss_path, output_path;
+};
+
+/// Parses navtwin's YAML configuration (keys in docs/gnss-ins.md). Unknown keys, missing
+/// required keys, non-positive sigmas: InputError naming file, line and key.
+GnssInsConfig LoadGnssInsConfig(const std::string& path);
+
+/// Reads a KF-GINS YAML configuration unchanged (imupath, gnsspath, outputpath,
+/// imudatalen, imudatarate, starttime, endtime, initpos [deg deg m], initvel [m/s],
+/// initatt [deg], initposstd [m], initvelstd [m/s], initattstd [deg], initgyrbias [deg/h],
+/// initaccbias [mGal], initgyrscale [ppm], initaccscale [ppm], initbgstd [deg/h],
+/// initbastd [mGal], initsgstd [ppm], initsastd [ppm], imunoise {arw [deg/sqrt(h)],
+/// vrw [m/s/sqrt(h)], gbstd [deg/h], abstd [mGal], gsstd [ppm], asstd [ppm], corrtime [h]},
+/// antlever [m]). Relative paths are taken relative to the current directory, as KF-GINS does.
+GnssInsConfig LoadKfginsConfig(const std::string& path);
+
+}  // namespace navtwin::gnss_ins

@@ -1,0 +1,38 @@
+// The input records of a GNSS/INS run, loaded and checked once (the filter and the batch
+// both need the whole record). IMU samples are in the body FRD axes (mounting applied)
+// on the GNSS time scale (time offset applied), with dt_s from the time tags.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/types.h"
+#include "problems/gnss_ins/config.h"
+
+namespace navtwin::gnss_ins {
+
+struct InputPaths {
+  std::string imu, gnss, mag, baro;  ///< mag and baro may be empty
+};
+
+struct Inputs {
+  InputPaths paths;
+  std::vector<ImuSample> imu;     ///< body axes, strictly increasing t_s, dt_s > 0
+  std::vector<GnssSample> gnss;   ///< strictly increasing; injected outages removed
+  std::vector<MagSample> mag;     ///< raw (calibration is applied by the models' users)
+  std::vector<BaroSample> baro;   ///< with altitude_m
+  std::size_t bridged_imu_gaps = 0;
+  std::size_t gnss_removed_by_outages = 0;
+  /// The injected outage intervals [start, end) in time (empty without outages).
+  std::vector<std::pair<double, double>> outages;
+};
+
+/// Reads every file (any format core/io/open.h detects), applies the installation, cuts
+/// to [start_time_s, end_time_s], injects the outages and checks: non-positive sigma, GNSS
+/// epochs out of order or duplicated, NaN, IMU gaps (bridged up to
+/// FilterConfig::max_bridge_gap_s by splitting the following sample's increments over the
+/// gap, longer ones are an InputError naming the file and time), no GNSS inside the IMU
+/// span. Throws InputError (file, line, field).
+Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config);
+
+}  // namespace navtwin::gnss_ins
