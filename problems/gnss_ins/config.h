@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "core/types.h"
+#include "problems/gnss_ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 

@@ -1,0 +1,94 @@
+// Priors on single state blocks (initial conditions of a batch problem):
+//
+// PositionPrior: r = PositionMinus(pos, p0) / sigma_ned        (3 residuals, NED metres;
+//   radii at p0). Block pos {lat_rad, lon_rad, h_m} (3, PositionManifold).
+// VectorPrior3:  r = (x - x0) / sigma                          (3 residuals)
+//   Block x (3, Euclidean): velocity, a bias, scale factors.
+// sigma per axis (Vector3d) or one for all axes (double); each > 0 and finite.
+#pragma once
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <ceres/autodiff_cost_function.h>
+#include <Eigen/Core>
+
+#include "factors/position_manifold.h"
+
+namespace navtwin {
+
+namespace state_prior_detail {
+inline Eigen::Vector3d InverseSigma(const Eigen::Vector3d& sigma, const char* what) {
+  for (int i = 0; i < 3; ++i) {
+    if (!(sigma[i] > 0.0) || !std::isfinite(sigma[i])) {
+      throw std::invalid_argument(std::string(what) + ": std must be positive and finite");
+    }
+  }
+  return sigma.cwiseInverse();
+}
+}  // namespace state_prior_detail
+
+class PositionPrior {
+ public:
+  static constexpr int kResiduals = 3;
+  static constexpr int kPositionSize = 3;  ///< block 0: {lat_rad, lon_rad, h_m}
+
+  PositionPrior(const Eigen::Vector3d& p0, const Eigen::Vector3d& std_ned_m)
+      : p0_(p0), inv_sigma_(state_prior_detail::InverseSigma(std_ned_m, "PositionPrior")) {
+    if (!p0.allFinite()) throw std::invalid_argument("PositionPrior: p0 must be finite");
+  }
+  PositionPrior(const Eigen::Vector3d& p0, double std_m) : PositionPrior(p0, Eigen::Vector3d::Constant(std_m)) {}
+
+  template <typename T>
+  bool operator()(const T* pos, T* residual) const {
+    const T p0[3] = {T(p0_[0]), T(p0_[1]), T(p0_[2])};
+    PositionMinus(pos, p0, residual);
+    for (int i = 0; i < 3; ++i) residual[i] *= T(inv_sigma_[i]);
+    return true;
+  }
+
+  /// 3 residuals; block pos (3).
+  static ceres::CostFunction* Create(const Eigen::Vector3d& p0, const Eigen::Vector3d& std_ned_m) {
+    return new ceres::AutoDiffCostFunction<PositionPrior, kResiduals, kPositionSize>(new PositionPrior(p0, std_ned_m));
+  }
+  static ceres::CostFunction* Create(const Eigen::Vector3d& p0, double std_m) {
+    return Create(p0, Eigen::Vector3d::Constant(std_m));
+  }
+
+ private:
+  Eigen::Vector3d p0_;
+  Eigen::Vector3d inv_sigma_;
+};
+
+class VectorPrior3 {
+ public:
+  static constexpr int kResiduals = 3;
+  static constexpr int kVectorSize = 3;  ///< block 0: x
+
+  VectorPrior3(const Eigen::Vector3d& x0, const Eigen::Vector3d& std)
+      : x0_(x0), inv_sigma_(state_prior_detail::InverseSigma(std, "VectorPrior3")) {
+    if (!x0.allFinite()) throw std::invalid_argument("VectorPrior3: x0 must be finite");
+  }
+  VectorPrior3(const Eigen::Vector3d& x0, double std) : VectorPrior3(x0, Eigen::Vector3d::Constant(std)) {}
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    for (int i = 0; i < 3; ++i) residual[i] = (x[i] - T(x0_[i])) * T(inv_sigma_[i]);
+    return true;
+  }
+
+  /// 3 residuals; block x (3).
+  static ceres::CostFunction* Create(const Eigen::Vector3d& x0, const Eigen::Vector3d& std) {
+    return new ceres::AutoDiffCostFunction<VectorPrior3, kResiduals, kVectorSize>(new VectorPrior3(x0, std));
+  }
+  static ceres::CostFunction* Create(const Eigen::Vector3d& x0, double std) {
+    return Create(x0, Eigen::Vector3d::Constant(std));
+  }
+
+ private:
+  Eigen::Vector3d x0_;
+  Eigen::Vector3d inv_sigma_;
+};
+
+}  // namespace navtwin

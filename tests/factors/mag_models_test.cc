@@ -1,0 +1,266 @@
+// MagVector, MagHeading and MagHeading2Axis: meaning (zero for the true attitude; a heading
+// estimate too large by d gives +d / sigma, also tilted; wrapping across +-pi; the 2-axis
+// form equals the 3-axis form when level), tangent-space Jacobians (through Linearize)
+// against central differences at identity, a tiny perturbation and a random attitude, and
+// the constructors' checks.
+#include "factors/mag_heading.h"
+#include "factors/mag_vector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/rotation.h"
+#include "factors/attitude_manifold.h"
+#include "solvers/linearize.h"
+
+namespace navtwin {
+namespace {
+
+// ---- Tangent-space Jacobian check (the same few lines in each model test file) ----
+// A parameter block at its ambient value, its manifold (nullptr: Euclidean) and the
+// central-difference step in its tangent space.
+struct Block {
+  std::vector<double> x;
+  const ceres::Manifold* manifold;
+  double step;
+};
+
+Eigen::VectorXd Residual(const ceres::CostFunction& f, const std::vector<Block>& blocks) {
+  std::vector<const double*> params;
+  for (const Block& b : blocks) params.push_back(b.x.data());
+  Eigen::VectorXd r(f.num_residuals());
+  EXPECT_TRUE(f.Evaluate(params.data(), r.data(), nullptr));
+  return r;
+}
+
+/// Block k moved by delta in its tangent space (manifold Plus, or +).
+std::vector<Block> Moved(std::vector<Block> blocks, int k, const Eigen::VectorXd& delta) {
+  Block& b = blocks[k];
+  std::vector<double> out(b.x.size());
+  if (b.manifold != nullptr) {
+    EXPECT_TRUE(b.manifold->Plus(b.x.data(), delta.data(), out.data()));
+  } else {
+    for (size_t i = 0; i < out.size(); ++i) out[i] = b.x[i] + delta[i];
+  }
+  b.x = out;
+  return blocks;
+}
+
+/// Central differences of the residual in block k's tangent space.
+Eigen::MatrixXd NumericTangentJacobian(const ceres::CostFunction& f, const std::vector<Block>& blocks, int k) {
+  const Block& b = blocks[k];
+  const int n = b.manifold != nullptr ? b.manifold->TangentSize() : static_cast<int>(b.x.size());
+  Eigen::MatrixXd jacobian(f.num_residuals(), n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::VectorXd h = b.step * Eigen::VectorXd::Unit(n, i);
+    jacobian.col(i) = (Residual(f, Moved(blocks, k, h)) - Residual(f, Moved(blocks, k, -h))) / (2.0 * b.step);
+  }
+  return jacobian;
+}
+
+Linearization LinearizeAt(const ceres::CostFunction& f, const std::vector<Block>& blocks) {
+  std::vector<const double*> params;
+  std::vector<const ceres::Manifold*> manifolds;
+  for (const Block& b : blocks) {
+    params.push_back(b.x.data());
+    manifolds.push_back(b.manifold);
+  }
+  return Linearize(f, params, manifolds);
+}
+
+/// Linearize's tangent Jacobians against central differences: max |J - J_num| <=
+/// tol * max(1, max |J|) per block; its residual equals Evaluate's (to rounding).
+void ExpectTangentJacobiansMatch(const ceres::CostFunction& f, const std::vector<Block>& blocks, double tol) {
+  const Linearization lin = LinearizeAt(f, blocks);
+  // Evaluate with and without Jacobians runs double vs Jet arithmetic: rounding only.
+  const Eigen::VectorXd r = Residual(f, blocks);
+  EXPECT_LE((lin.residual - r).norm(), 1e-14 * (1.0 + r.norm()));
+  ASSERT_EQ(lin.jacobians.size(), blocks.size());
+  for (size_t k = 0; k < blocks.size(); ++k) {
+    SCOPED_TRACE("block " + std::to_string(k));
+    const Eigen::MatrixXd numeric = NumericTangentJacobian(f, blocks, static_cast<int>(k));
+    ASSERT_EQ(lin.jacobians[k].rows(), numeric.rows());
+    ASSERT_EQ(lin.jacobians[k].cols(), numeric.cols());
+    const double scale = std::max(1.0, lin.jacobians[k].cwiseAbs().maxCoeff());
+    EXPECT_LE((lin.jacobians[k] - numeric).cwiseAbs().maxCoeff(), tol * scale)
+        << "analytic\n" << lin.jacobians[k] << "\nnumeric\n" << numeric;
+  }
+}
+
+[[maybe_unused]] std::vector<double> Std(const Eigen::Vector3d& v) { return {v[0], v[1], v[2]}; }
+[[maybe_unused]] std::vector<double> Std(const Eigen::Quaterniond& q) { return {q.x(), q.y(), q.z(), q.w()}; }
+
+// The three test points: zero / identity, a tiny perturbation of it, a random state.
+struct State {
+  std::string name;
+  Eigen::Vector3d pos;  // lat_rad, lon_rad, h_m
+  Eigen::Quaterniond q_n_b;
+  Eigen::Vector3d v_n_mps;
+};
+
+std::vector<State> States() {
+  std::mt19937 rng(20240917);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto random3 = [&]() -> Eigen::Vector3d { return Eigen::Vector3d(u(rng), u(rng), u(rng)); };
+  std::vector<State> states;
+  states.push_back({"zero", Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()});
+  states.push_back({"tiny", Eigen::Vector3d(1e-9, -1e-9, 1e-9), QuatFromRotVec<double>(Eigen::Vector3d(1e-9, -2e-9, 3e-9)),
+                    Eigen::Vector3d(1e-9, 2e-9, -1e-9)});
+  const Eigen::Vector3d pos(80.0 * M_PI / 180.0 * u(rng), M_PI * u(rng), 2500.0 + 2500.0 * u(rng));
+  const Eigen::Vector3d phi = 3.0 * std::abs(u(rng)) * random3().normalized();
+  states.push_back({"random", pos, QuatFromRotVec<double>(phi), 30.0 * random3()});
+  return states;
+}
+// ---- end of the tangent-space Jacobian check ----
+
+const AttitudeManifold kAttitudeManifold;
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Central differences with step 1e-6 rad: truncation ~h^2 |r'''| / 6 and rounding
+// ~eps |r| / h; with |r| <= ~100 (50 uT / 0.5 uT) both are <= 1e-8, so 1e-7 relative to
+// max(1, |J|) is safe and far below any real error.
+constexpr double kAttStep = 1e-6;
+constexpr double kJacobianTol = 1e-7;
+
+/// A local field in NED: horizontal part H (uT) towards azimuth D (east of true north),
+/// vertical part Z (uT, down positive). Defaults: ~49 uT, inclination ~66 deg (mid-latitude).
+Eigen::Vector3d Field(double declination_rad, double horizontal_uT = 20.0, double down_uT = 45.0) {
+  return Eigen::Vector3d(horizontal_uT * std::cos(declination_rad), horizontal_uT * std::sin(declination_rad), down_uT);
+}
+
+double Eval1(const ceres::CostFunction& f, const Eigen::Quaterniond& q) {
+  return Residual(f, {{Std(q), nullptr, 0.0}})[0];
+}
+
+TEST(MagVector, ZeroForTheTrueAttitudeAndFirstOrderInTheError) {
+  const Eigen::Quaterniond q = QuatFromEuler(0.2, -0.3, 2.2);
+  const Eigen::Vector3d m_n = Field(0.05);
+  const double sigma = 0.5;
+  const Eigen::Vector3d m_b = DcmFromQuat(q).transpose() * m_n;
+  const std::unique_ptr<ceres::CostFunction> f(MagVector::Create(m_b, m_n, sigma));
+  EXPECT_LT(Residual(*f, {{Std(q), nullptr, 0.0}}).norm(), 1e-13);  // rounding of 50 uT / 0.5
+  // Estimate with attitude error: R_est = Exp(-phi) R_true (phi = true minus estimate),
+  // R_est^T m_n = R_true^T Exp(phi) m_n ~ m_b + R_true^T (phi x m_n).
+  const Eigen::Vector3d phi(0.001, -0.002, 0.003);
+  const Eigen::Quaterniond q_est = ApplyAttitudeError<double>(-phi, q);
+  const Eigen::Vector3d expected = DcmFromQuat(q).transpose() * phi.cross(m_n) / sigma;
+  // Second-order term |phi|^2 |m| / 2 / sigma ~ 1.4e-5 * 50 / 2 / 0.5 ~ 7e-4.
+  EXPECT_LT((Residual(*f, {{Std(q_est), nullptr, 0.0}}) - expected).norm(), 1e-3);
+}
+
+TEST(MagVector, TangentJacobianMatchesCentralDifferences) {
+  for (const State& s : States()) {
+    SCOPED_TRACE(s.name);
+    const Eigen::Vector3d m_n = Field(0.1);
+    const Eigen::Vector3d m_b = DcmFromQuat(s.q_n_b).transpose() * m_n + Eigen::Vector3d(0.3, -0.2, 0.5);
+    const std::unique_ptr<ceres::CostFunction> f(MagVector::Create(m_b, m_n, 0.5));
+    const std::vector<Block> blocks = {{Std(s.q_n_b), &kAttitudeManifold, kAttStep}};
+    ExpectTangentJacobiansMatch(*f, blocks, kJacobianTol);
+    // d(Exp(phi) R)^T m_n / d phi = R^T [m_n]x.
+    const Linearization lin = LinearizeAt(*f, blocks);
+    EXPECT_LT((lin.jacobians[0] - DcmFromQuat(s.q_n_b).transpose() * Skew<double>(m_n) / 0.5).norm(), 1e-12);
+  }
+}
+
+TEST(MagVector, RejectsBadSigma) {
+  const Eigen::Vector3d m = Field(0.0);
+  for (const double bad : {0.0, -1.0, kNaN, kInf}) EXPECT_THROW(MagVector(m, m, bad), std::invalid_argument) << bad;
+  EXPECT_THROW(MagVector(Eigen::Vector3d(kNaN, 0, 0), m, 1.0), std::invalid_argument);
+}
+
+TEST(MagHeading, ZeroForTrueAttitudeAndPlusDForHeadingTooLarge) {
+  const double declination = 3.0 * kDeg, sigma = 0.02;
+  const Eigen::Vector3d m_n = Field(declination);
+  for (const Eigen::Vector3d& euler : {Eigen::Vector3d(0.0, 0.0, 0.7), Eigen::Vector3d(0.3, -0.25, -2.0),
+                                       Eigen::Vector3d(-0.1, 0.4, 3.1)}) {
+    SCOPED_TRACE(euler.transpose());
+    const Eigen::Quaterniond q = QuatFromEuler(euler.x(), euler.y(), euler.z());
+    const Eigen::Vector3d m_b = DcmFromQuat(q).transpose() * m_n;
+    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, declination, sigma));
+    EXPECT_NEAR(Eval1(*f, q), 0.0, 1e-12);  // atan2 rounding ~1e-16 rad / 0.02
+    // Same roll and pitch, yaw larger by d: R_est = Rz(d) R_true.
+    for (const double d : {0.01, -0.2, 1.5}) {
+      const Eigen::Quaterniond q_est = QuatFromEuler(euler.x(), euler.y(), euler.z() + d);
+      EXPECT_NEAR(Eval1(*f, q_est) * sigma, d, 1e-12) << d;
+    }
+  }
+}
+
+TEST(MagHeading, WrapsAcrossPlusMinusPi) {
+  // Magnetic north at D = 170 deg; estimated heading 20 deg too large: the raw difference
+  // of the azimuths is 190 - 360 - 170 = -340 deg, wrapped +20 deg.
+  const double declination = 170.0 * kDeg, sigma = 0.1;
+  const Eigen::Vector3d m_n = Field(declination);
+  const Eigen::Quaterniond q = QuatFromEuler(0.0, 0.0, 0.5);
+  const std::unique_ptr<ceres::CostFunction> f(
+      MagHeading::Create(DcmFromQuat(q).transpose() * m_n, declination, sigma));
+  const Eigen::Quaterniond q_est = QuatFromEuler(0.0, 0.0, 0.5 + 20.0 * kDeg);
+  EXPECT_NEAR(Eval1(*f, q_est) * sigma, 20.0 * kDeg, 1e-12);
+  const Eigen::Quaterniond q_est2 = QuatFromEuler(0.0, 0.0, 0.5 - 20.0 * kDeg);
+  EXPECT_NEAR(Eval1(*f, q_est2) * sigma, -20.0 * kDeg, 1e-12);
+}
+
+TEST(MagHeading, TangentJacobianMatchesCentralDifferences) {
+  for (const State& s : States()) {
+    SCOPED_TRACE(s.name);
+    const Eigen::Vector3d m_b = DcmFromQuat(s.q_n_b).transpose() * Field(0.2) + Eigen::Vector3d(0.5, -1.0, 0.3);
+    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, 0.1, 0.05));
+    ExpectTangentJacobiansMatch(*f, {{Std(s.q_n_b), &kAttitudeManifold, kAttStep}}, kJacobianTol);
+  }
+}
+
+TEST(MagHeading2Axis, MatchesMagHeadingWhenLevel) {
+  const double declination = -7.0 * kDeg, sigma = 0.03;
+  const Eigen::Vector3d m_n = Field(declination);
+  for (const double yaw_true : {0.0, 1.2, -2.9, M_PI}) {
+    const Eigen::Vector3d m_b = DcmFromQuat(QuatFromEuler(0.0, 0.0, yaw_true)).transpose() * m_n;
+    const std::unique_ptr<ceres::CostFunction> f3(MagHeading::Create(m_b, declination, sigma));
+    const std::unique_ptr<ceres::CostFunction> f2(MagHeading2Axis::Create(m_b.x(), m_b.y(), declination, sigma));
+    for (const double d : {0.0, 0.05, -0.6, 2.5}) {
+      SCOPED_TRACE("yaw " + std::to_string(yaw_true) + " d " + std::to_string(d));
+      const Eigen::Quaterniond q_est = QuatFromEuler(0.0, 0.0, yaw_true + d);
+      // Both are wrap(yaw_est - yaw_true) / sigma; atan2 rounding ~1e-16 / 0.03.
+      EXPECT_NEAR(Eval1(*f2, q_est), Eval1(*f3, q_est), 1e-12);
+      EXPECT_NEAR(Eval1(*f2, q_est) * sigma, d, 1e-12);
+      // In the tangent, a rotation about down moves the heading one for one:
+      // d r / d phi_d = 1 / sigma for both (the tilt columns differ: the 3-axis form sees
+      // the vertical field tilt into the horizontal plane).
+      const std::vector<Block> blocks = {{Std(q_est), &kAttitudeManifold, 0.0}};
+      EXPECT_NEAR(LinearizeAt(*f2, blocks).jacobians[0](0, 2), 1.0 / sigma, 1e-10);
+      EXPECT_NEAR(LinearizeAt(*f3, blocks).jacobians[0](0, 2), 1.0 / sigma, 1e-10);
+    }
+  }
+}
+
+TEST(MagHeading2Axis, MeasuredHeadingAndTangentJacobian) {
+  // A level compass heading 90 deg (east) sees magnetic north (D = 0) on its left: my < 0.
+  const MagHeading2Axis east(0.0, -20.0, 0.0, 0.1);
+  EXPECT_NEAR(east.heading_meas_rad(), M_PI / 2, 1e-15);
+  for (const State& s : States()) {
+    SCOPED_TRACE(s.name);
+    const std::unique_ptr<ceres::CostFunction> f(MagHeading2Axis::Create(15.0, -7.0, 0.05, 0.05));
+    ExpectTangentJacobiansMatch(*f, {{Std(s.q_n_b), &kAttitudeManifold, kAttStep}}, kJacobianTol);
+  }
+}
+
+TEST(MagHeading, RejectsBadSigma) {
+  for (const double bad : {0.0, -1.0, kNaN, kInf}) {
+    EXPECT_THROW(MagHeading(Field(0.0), 0.0, bad), std::invalid_argument) << bad;
+    EXPECT_THROW(MagHeading2Axis(20.0, 1.0, 0.0, bad), std::invalid_argument) << bad;
+  }
+  EXPECT_THROW(MagHeading(Field(0.0), kNaN, 0.1), std::invalid_argument);
+  EXPECT_THROW(MagHeading2Axis(kInf, 1.0, 0.0, 0.1), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace navtwin
