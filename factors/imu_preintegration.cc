@@ -1,0 +1,327 @@
+#include "factors/imu_preintegration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include <ceres/autodiff_cost_function.h>
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+
+#include "core/earth.h"
+#include "core/rotation.h"
+#include "factors/position_manifold.h"
+
+namespace navtwin {
+namespace {
+
+using Matrix9d = ImuPreintegration::Matrix9d;
+
+/// SO(3) right Jacobian, Exp(phi + e) = Exp(phi) Exp(J_r(phi) e) to first order in e:
+///   J_r(phi) = I - (1 - cos t)/t^2 [phi]x + (t - sin t)/t^3 [phi]x^2,  t = |phi|,
+/// with the series 1/2 - t^2/24 and 1/6 - t^2/120 below t = 1e-4 (truncation < 1e-18).
+Eigen::Matrix3d RightJacobian(const Eigen::Vector3d& phi) {
+  const double t2 = phi.squaredNorm();
+  double c1, c2;
+  if (t2 < 1e-8) {
+    c1 = 0.5 - t2 / 24.0;
+    c2 = 1.0 / 6.0 - t2 / 120.0;
+  } else {
+    const double t = std::sqrt(t2);
+    c1 = (1.0 - std::cos(t)) / t2;
+    c2 = (t - std::sin(t)) / (t2 * t);
+  }
+  const Eigen::Matrix3d k = Skew<double>(phi);
+  return Eigen::Matrix3d::Identity() - c1 * k + c2 * k * k;
+}
+
+/// What the factor needs from a preintegration (copied when the factor is made).
+struct ImuFactorData {
+  double dt_s = 0.0;
+  Eigen::Quaterniond delta_q = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d delta_v = Eigen::Vector3d::Zero(), delta_p = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d J_R_bg, J_v_bg, J_v_ba, J_p_bg, J_p_ba;
+  Eigen::Vector3d bg_lin = Eigen::Vector3d::Zero(), ba_lin = Eigen::Vector3d::Zero();
+  Matrix9d sqrt_information = Matrix9d::Identity();  // S = L^-1
+  bool whiten = true;
+};
+
+ImuFactorData MakeData(const ImuPreintegration& pre, bool whiten) {
+  if (!(pre.dt_s() > 0.0) || pre.num_samples() == 0) {
+    throw std::invalid_argument("ImuFactor: the preintegration has no sample");
+  }
+  ImuFactorData d;
+  d.dt_s = pre.dt_s();
+  d.delta_q = pre.delta_q();
+  d.delta_v = pre.delta_v_mps();
+  d.delta_p = pre.delta_p_m();
+  d.J_R_bg = pre.J_R_bg();
+  d.J_v_bg = pre.J_v_bg();
+  d.J_v_ba = pre.J_v_ba();
+  d.J_p_bg = pre.J_p_bg();
+  d.J_p_ba = pre.J_p_ba();
+  d.bg_lin = pre.bg_lin_radps();
+  d.ba_lin = pre.ba_lin_mps2();
+  d.whiten = whiten;
+  if (whiten) d.sqrt_information = pre.SqrtInformation();
+  return d;
+}
+
+// The IMU residual (docs/imu-preintegration.md). With dt = t_j - t_i, dbg = bg_i - bg_lin,
+// dba = ba_i - ba_lin, the bias-corrected increments
+//   dR = dR_lin Exp(J_R_bg dbg),  dv = dv_lin + J_v_bg dbg + J_v_ba dba,  dp likewise,
+// the midpoint lat_m = (lat_i + lat_j)/2, h_m = (h_i + h_j)/2, the displacement
+//   D = NED displacement i -> j with the radii at (lat_m, h_m)   (= integral of v_n dt),
+// the mean velocity v_m = D / dt, and
+//   w_ie = EarthRateNed(lat_m),  w_en = TransportRateNed(lat_m, h_m, v_m),
+//   w_in = w_ie + w_en,  c = 2 w_ie + w_en,  g = GravityNed(lat_m, h_m),
+// the prediction, to first order in w_in dt:
+//   R_pred  = Exp(-w_in dt) R_i dR
+//   v_pred  = v_i + R_i dv - w_in x R_i (dv dt - dp) + g dt - c x D
+//   D_pred  = v_i dt + R_i dp - w_in x R_i dv dt^2/6 + g dt^2/2
+//             - c x (D dt/2 + (v_i - v_j) dt^2/12)
+// and the residuals (prediction minus state, NED):
+//   r_phi = Log(R_pred R_j^T),  r_v = v_pred - v_j,  r_p = D_pred - D.
+// Whitening: the preintegration noise (dphi in body j, dv and dp in body i) appears in the
+// residuals as (R_pred dphi, R_i dv, R_i dp) up to O(w_in dt) ~ 1e-4, so
+//   r_w = S [R_pred^T r_phi; R_i^T r_v; R_i^T r_p],  R_pred^T r_phi = Log(R_j^T R_pred),
+// with S = L^-1, L L^T the preintegration covariance.
+class ImuFactor {
+ public:
+  explicit ImuFactor(ImuFactorData data) : d_(std::move(data)) {}
+
+  template <typename T>
+  bool operator()(const T* pos_i, const T* vel_i, const T* q_i_ptr, const T* bg_i, const T* ba_i,
+                  const T* pos_j, const T* vel_j, const T* q_j_ptr, T* residual_ptr) const {
+    const T dt(d_.dt_s);
+    const Eigen::Map<const Vector3<T>> v_i(vel_i), v_j(vel_j);
+    const Quaternion<T> q_i = Eigen::Map<const Quaternion<T>>(q_i_ptr).normalized();
+    const Quaternion<T> q_j = Eigen::Map<const Quaternion<T>>(q_j_ptr).normalized();
+    const Vector3<T> dbg = Eigen::Map<const Vector3<T>>(bg_i) - d_.bg_lin.cast<T>();
+    const Vector3<T> dba = Eigen::Map<const Vector3<T>>(ba_i) - d_.ba_lin.cast<T>();
+
+    // Bias-corrected increments (first order).
+    const Quaternion<T> dq = d_.delta_q.cast<T>() * QuatFromRotVec<T>(d_.J_R_bg.cast<T>() * dbg);
+    const Vector3<T> dv = d_.delta_v.cast<T>() + d_.J_v_bg.cast<T>() * dbg + d_.J_v_ba.cast<T>() * dba;
+    const Vector3<T> dp = d_.delta_p.cast<T>() + d_.J_p_bg.cast<T>() * dbg + d_.J_p_ba.cast<T>() * dba;
+
+    // Earth model at the interval midpoint, with the mean velocity over the interval.
+    const T lat_m = (pos_i[0] + pos_j[0]) * T(0.5);
+    const T h_m = (pos_i[2] + pos_j[2]) * T(0.5);
+    // Displacement i -> j in NED metres with the radii at the midpoint: the difference of
+    // the two positions' offsets from a point at (lat_m, lon_i, h_m).
+    const T p_mid[3] = {lat_m, pos_i[1], h_m};
+    Vector3<T> off_j, off_i;
+    PositionMinus(pos_j, p_mid, off_j.data());
+    PositionMinus(pos_i, p_mid, off_i.data());
+    const Vector3<T> D = off_j - off_i;
+
+    const Vector3<T> v_m = D / dt;
+    const Vector3<T> w_ie = wgs84::EarthRateNed(lat_m);
+    const Vector3<T> w_en = wgs84::TransportRateNed(lat_m, h_m, v_m);
+    const Vector3<T> w_in = w_ie + w_en;
+    const Vector3<T> c = T(2) * w_ie + w_en;
+    const Vector3<T> g = wgs84::GravityNed(lat_m, h_m);
+
+    const Matrix3<T> R_i = q_i.toRotationMatrix();
+    const Vector3<T> Rdv = R_i * dv;
+    const Vector3<T> Rdp = R_i * dp;
+
+    const Quaternion<T> q_pred = QuatFromRotVec<T>(-w_in * dt) * q_i * dq;
+    const Vector3<T> v_pred = v_i + Rdv - w_in.cross(Rdv * dt - Rdp) + g * dt - c.cross(D);
+    const Vector3<T> D_pred = v_i * dt + Rdp - w_in.cross(Rdv) * (dt * dt / T(6)) +
+                              g * (dt * dt * T(0.5)) -
+                              c.cross(D * (dt * T(0.5)) + (v_i - v_j) * (dt * dt / T(12)));
+
+    Eigen::Map<Eigen::Matrix<T, 9, 1>> residual(residual_ptr);
+    if (!d_.whiten) {
+      residual.template segment<3>(0) = AttitudeError<T>(q_pred, q_j);  // Log(R_pred R_j^T)
+      residual.template segment<3>(3) = v_pred - v_j;
+      residual.template segment<3>(6) = D_pred - D;
+      return true;
+    }
+    Eigen::Matrix<T, 9, 1> r_body;
+    r_body.template segment<3>(0) = RotVecFromQuat<T>(Quaternion<T>(q_j.conjugate() * q_pred));
+    r_body.template segment<3>(3) = R_i.transpose() * (v_pred - v_j);
+    r_body.template segment<3>(6) = R_i.transpose() * (D_pred - D);
+    residual = d_.sqrt_information.cast<T>() * r_body;
+    return true;
+  }
+
+ private:
+  ImuFactorData d_;
+};
+
+}  // namespace
+
+ImuPreintegration::ImuPreintegration(const Eigen::Vector3d& bg_lin_radps,
+                                     const Eigen::Vector3d& ba_lin_mps2,
+                                     double gyro_arw_rad_per_sqrt_s,
+                                     double accel_vrw_mps_per_sqrt_s)
+    : bg_lin_(bg_lin_radps),
+      ba_lin_(ba_lin_mps2),
+      gyro_arw_(gyro_arw_rad_per_sqrt_s),
+      accel_vrw_(accel_vrw_mps_per_sqrt_s) {
+  if (!bg_lin_radps.allFinite() || !ba_lin_mps2.allFinite()) {
+    throw std::invalid_argument("ImuPreintegration: the linearisation biases must be finite");
+  }
+  if (!(gyro_arw_ > 0.0) || !std::isfinite(gyro_arw_)) {
+    throw std::invalid_argument("ImuPreintegration: gyro ARW must be positive and finite");
+  }
+  if (!(accel_vrw_ > 0.0) || !std::isfinite(accel_vrw_)) {
+    throw std::invalid_argument("ImuPreintegration: accelerometer VRW must be positive and finite");
+  }
+  Reset();
+}
+
+void ImuPreintegration::Reset() {
+  dt_s_ = 0.0;
+  delta_q_ = Eigen::Quaterniond::Identity();
+  delta_R_ = Eigen::Matrix3d::Identity();
+  delta_v_.setZero();
+  delta_p_.setZero();
+  covariance_.setZero();
+  J_bg_.setZero();
+  J_ba_.setZero();
+}
+
+double ImuPreintegration::t_start_s() const {
+  return samples_.empty() ? std::numeric_limits<double>::quiet_NaN()
+                          : samples_.front().t_s - samples_.front().dt_s;
+}
+
+double ImuPreintegration::t_end_s() const {
+  return samples_.empty() ? std::numeric_limits<double>::quiet_NaN() : samples_.back().t_s;
+}
+
+void ImuPreintegration::Integrate(const ImuSample& s) {
+  if (!(s.dt_s > 0.0) || !std::isfinite(s.dt_s) || !std::isfinite(s.t_s)) {
+    throw std::invalid_argument("ImuPreintegration: sample at t = " + std::to_string(s.t_s) +
+                                " s has a non-positive or non-finite dt_s");
+  }
+  if (!s.dtheta_b_rad.allFinite() || !s.dv_b_mps.allFinite()) {
+    throw std::invalid_argument("ImuPreintegration: sample at t = " + std::to_string(s.t_s) +
+                                " s has non-finite increments");
+  }
+  if (!samples_.empty()) {
+    const double gap = (s.t_s - s.dt_s) - samples_.back().t_s;
+    if (std::abs(gap) > std::max(1e-6, 1e-3 * s.dt_s)) {
+      throw std::invalid_argument("ImuPreintegration: sample at t = " + std::to_string(s.t_s) +
+                                  " s does not start where the previous one ended (gap " +
+                                  std::to_string(gap) + " s)");
+    }
+  }
+  samples_.push_back(s);
+  Propagate(s);
+}
+
+void ImuPreintegration::Reintegrate(const Eigen::Vector3d& bg_lin_radps,
+                                    const Eigen::Vector3d& ba_lin_mps2) {
+  if (!bg_lin_radps.allFinite() || !ba_lin_mps2.allFinite()) {
+    throw std::invalid_argument("ImuPreintegration::Reintegrate: biases must be finite");
+  }
+  bg_lin_ = bg_lin_radps;
+  ba_lin_ = ba_lin_mps2;
+  Reset();
+  for (const ImuSample& s : samples_) Propagate(s);
+}
+
+// One sample, bias-corrected a = dtheta - bg dt, u = dv - ba dt (docs/imu-preintegration.md).
+// Error propagation, x = (dphi, dv, dp), noise n_g on a, n_a on u:
+//   x_k = A x_{k-1} + B_g n_g + B_a n_a
+//   A   = [ Exp(a)^T       0     0 ]      B_g = [ J_r(a)                  ]
+//         [ -dR [w]x       I     0 ]            [ -1/2 dR [u]x            ]
+//         [ -dR [s]x dt    I dt  I ]            [ -1/6 dR [u]x dt         ]
+//   B_a = [ 0; dR (I + 1/2 [a]x); dR (1/2 I + 1/6 [a]x) dt ],
+//   w = u + 1/2 a x u,  s = 1/2 u + 1/6 a x u,  dR = dR_{k-1}.
+// A bias change db is the noise -db dt, so J_bg <- A J_bg - B_g dt, J_ba <- A J_ba - B_a dt
+// (exact derivatives of the discrete recursion). The covariance uses B_g with
+// var(n_g) = ARW^2 dt I, and for the accelerometer the continuous-time integral of white
+// noise over the sample, rotated by dR (isotropic, so the rotation drops out):
+//   cov(dv, dv) = VRW^2 dt I, cov(dv, dp) = VRW^2 dt^2/2 I, cov(dp, dp) = VRW^2 dt^3/3 I
+// (the 1/2 [a]x, 1/6 [a]x terms of B_a, relative size |a| < 1e-2, are left out of the
+// covariance).
+void ImuPreintegration::Propagate(const ImuSample& sample) {
+  const double dt = sample.dt_s;
+  const Eigen::Vector3d a = sample.dtheta_b_rad - bg_lin_ * dt;
+  const Eigen::Vector3d u = sample.dv_b_mps - ba_lin_ * dt;
+  const Eigen::Matrix3d& dR = delta_R_;  // dR_{k-1}
+  const Eigen::Vector3d w = u + 0.5 * a.cross(u);
+  const Eigen::Vector3d s = 0.5 * u + a.cross(u) / 6.0;
+  const Eigen::Quaterniond q_a = QuatFromRotVec<double>(a);
+  const Eigen::Matrix3d R_a = q_a.toRotationMatrix();
+  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
+
+  Matrix9d A = Matrix9d::Identity();
+  A.block<3, 3>(0, 0) = R_a.transpose();
+  A.block<3, 3>(3, 0) = -dR * Skew<double>(w);
+  A.block<3, 3>(6, 0) = -dR * Skew<double>(s) * dt;
+  A.block<3, 3>(6, 3) = I3 * dt;
+  Eigen::Matrix<double, 9, 3> B_g, B_a;
+  B_g.block<3, 3>(0, 0) = RightJacobian(a);
+  B_g.block<3, 3>(3, 0) = -0.5 * dR * Skew<double>(u);
+  B_g.block<3, 3>(6, 0) = -dR * Skew<double>(u) * (dt / 6.0);
+  B_a.block<3, 3>(0, 0).setZero();
+  B_a.block<3, 3>(3, 0) = dR * (I3 + 0.5 * Skew<double>(a));
+  B_a.block<3, 3>(6, 0) = dR * (0.5 * I3 + Skew<double>(a) / 6.0) * dt;
+
+  J_bg_ = A * J_bg_ - B_g * dt;
+  J_ba_ = A * J_ba_ - B_a * dt;
+
+  Matrix9d Q = gyro_arw_ * gyro_arw_ * dt * B_g * B_g.transpose();
+  const double qa = accel_vrw_ * accel_vrw_;
+  Q.block<3, 3>(3, 3) += qa * dt * I3;
+  Q.block<3, 3>(3, 6) += qa * dt * dt / 2.0 * I3;
+  Q.block<3, 3>(6, 3) += qa * dt * dt / 2.0 * I3;
+  Q.block<3, 3>(6, 6) += qa * dt * dt * dt / 3.0 * I3;
+  covariance_ = A * covariance_ * A.transpose() + Q;
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
+
+  // The state itself (after the Jacobians, which use dR_{k-1}).
+  delta_p_ += delta_v_ * dt + dR * s * dt;
+  delta_v_ += dR * w;
+  delta_q_ = (delta_q_ * q_a).normalized();
+  delta_R_ = delta_q_.toRotationMatrix();
+  dt_s_ += dt;
+}
+
+ImuPreintegration::Matrix9d ImuPreintegration::SqrtInformation() const {
+  const Eigen::LLT<Matrix9d> llt(covariance_);
+  if (samples_.empty() || llt.info() != Eigen::Success) {
+    throw std::domain_error("ImuPreintegration: covariance not positive definite");
+  }
+  const Matrix9d L = llt.matrixL();
+  return L.triangularView<Eigen::Lower>().solve(Matrix9d::Identity());
+}
+
+ImuPreintegration::Deltas ImuPreintegration::Corrected(const Eigen::Vector3d& bg_radps,
+                                                       const Eigen::Vector3d& ba_mps2) const {
+  const Eigen::Vector3d dbg = bg_radps - bg_lin_, dba = ba_mps2 - ba_lin_;
+  Deltas d;
+  d.delta_q = (delta_q_ * QuatFromRotVec<double>(J_R_bg() * dbg)).normalized();
+  d.delta_v_mps = delta_v_ + J_v_bg() * dbg + J_v_ba() * dba;
+  d.delta_p_m = delta_p_ + J_p_bg() * dbg + J_p_ba() * dba;
+  return d;
+}
+
+ceres::CostFunction* CreateImuFactor(std::shared_ptr<const ImuPreintegration> pre) {
+  if (!pre) throw std::invalid_argument("CreateImuFactor: null preintegration");
+  return new ceres::AutoDiffCostFunction<ImuFactor, 9, 3, 3, 4, 3, 3, 3, 3, 4>(
+      new ImuFactor(MakeData(*pre, /*whiten=*/true)));
+}
+
+Eigen::Matrix<double, 9, 1> ImuFactorResidual(const ImuPreintegration& pre, const double* pos_i,
+                                              const double* vel_i, const double* q_i,
+                                              const double* bg_i, const double* ba_i,
+                                              const double* pos_j, const double* vel_j,
+                                              const double* q_j, bool whitened) {
+  const ImuFactor factor(MakeData(pre, whitened));
+  Eigen::Matrix<double, 9, 1> r;
+  factor(pos_i, vel_i, q_i, bg_i, ba_i, pos_j, vel_j, q_j, r.data());
+  return r;
+}
+
+}  // namespace navtwin
