@@ -1,10 +1,15 @@
 #include "solvers/batch_driver.h"
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <ceres/covariance.h>
@@ -12,6 +17,9 @@
 #include <ceres/iteration_callback.h>
 #include <ceres/solver.h>
 #include <Eigen/Eigenvalues>
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 
 namespace navtwin {
 namespace {
@@ -280,6 +288,282 @@ std::optional<Eigen::MatrixXd> TangentCovariance(ceres::Problem& problem, const 
 
 std::optional<Eigen::MatrixXd> TangentCovariance(ceres::Problem& problem, const std::vector<const double*>& blocks) {
   return ComputeTangentCovariance(problem, blocks).covariance;
+}
+
+// ---------------------------------------------------------------------------------------
+// ComputeBlockDiagonalCovariance
+
+namespace {
+
+using RowMajorBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// Diagonal of J^T J from the sparse tangent Jacobian.
+Eigen::VectorXd NormalDiagonal(const ceres::CRSMatrix& crs) {
+  Eigen::VectorXd h = Eigen::VectorXd::Zero(crs.num_cols);
+  for (std::size_t k = 0; k < crs.values.size(); ++k) h(crs.cols[k]) += crs.values[k] * crs.values[k];
+  return h;
+}
+
+/// First tangent column of every free block (constant blocks are absent).
+std::unordered_map<const double*, int> ColumnMap(const TangentJacobian& jacobian) {
+  std::unordered_map<const double*, int> map;
+  for (std::size_t i = 0; i < jacobian.blocks.size(); ++i) map.emplace(jacobian.blocks[i], jacobian.offsets[i]);
+  return map;
+}
+
+/// Drops the covariance of every block with a coordinate whose variance inflation
+/// H_ii * P_ii exceeds 1 / min_reciprocal_condition_number (or is not finite) and names
+/// them in the message.
+void RejectInflated(const std::vector<Eigen::VectorXd>& inflation, double min_reciprocal_condition_number,
+                    BlockCovarianceResult* result) {
+  std::ostringstream names;
+  int rejected = 0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < inflation.size(); ++i) {
+    if (!result->covariances[i] || inflation[i].size() == 0) continue;
+    const double max_inflation = inflation[i].maxCoeff();
+    if (inflation[i].allFinite() && max_inflation <= 1.0 / min_reciprocal_condition_number) continue;
+    result->covariances[i].reset();
+    if (rejected < 10) names << (rejected > 0 ? ", " : "") << i;
+    ++rejected;
+    worst = std::isfinite(max_inflation) ? std::max(worst, max_inflation) : max_inflation;
+  }
+  if (rejected > 0) {
+    std::ostringstream text;
+    text << rejected << " block(s) numerically unobservable (variance inflation H_ii P_ii up to " << worst
+         << " > 1 / min_reciprocal_condition_number): " << names.str() << (rejected > 10 ? ", ..." : "");
+    result->message = text.str();
+  }
+}
+
+void BlockCovarianceBySparseQr(ceres::Problem& problem, const std::vector<const double*>& blocks,
+                               const TangentJacobian& jacobian, const BlockCovarianceOptions& options,
+                               BlockCovarianceResult* result) {
+  ceres::Covariance::Options ceres_options;
+  ceres_options.algorithm_type = ceres::SPARSE_QR;
+  ceres_options.min_reciprocal_condition_number = options.min_reciprocal_condition_number;
+  ceres_options.null_space_rank = 0;
+  ceres_options.num_threads = options.num_threads;
+  ceres::Covariance covariance(ceres_options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  pairs.reserve(blocks.size());
+  for (const double* block : blocks) pairs.emplace_back(block, block);
+  if (!covariance.Compute(pairs, &problem)) {
+    result->message = "covariance not computable (sparse QR): the Jacobian is rank deficient";
+    return;
+  }
+  const Eigen::VectorXd h = NormalDiagonal(jacobian.crs);
+  const std::unordered_map<const double*, int> columns = ColumnMap(jacobian);
+  std::vector<Eigen::VectorXd> inflation(blocks.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const int size = problem.ParameterBlockTangentSize(blocks[i]);
+    RowMajorBlock block(size, size);
+    if (!covariance.GetCovarianceBlockInTangentSpace(blocks[i], blocks[i], block.data())) {
+      result->message = "ceres::Covariance::GetCovarianceBlockInTangentSpace failed";
+      result->covariances.assign(blocks.size(), std::nullopt);
+      return;
+    }
+    result->covariances[i] = Eigen::MatrixXd(block);
+    const auto column = columns.find(blocks[i]);
+    if (column != columns.end()) {
+      inflation[i] = h.segment(column->second, size).cwiseProduct(block.diagonal());
+    }
+  }
+  RejectInflated(inflation, options.min_reciprocal_condition_number, result);
+}
+
+/// The lower triangle of the factor by columns, row indices increasing (strictly below
+/// the diagonal; L has a unit diagonal).
+struct LowerFactor {
+  std::vector<int> start;  ///< column j holds entries [start[j], start[j + 1])
+  std::vector<int> rows;
+  std::vector<double> values;
+
+  /// Index of entry (row, column), row > column, or -1 when not in the pattern.
+  int Find(int row, int column) const {
+    const auto first = rows.begin() + start[column];
+    const auto last = rows.begin() + start[column + 1];
+    const auto it = std::lower_bound(first, last, row);
+    return (it != last && *it == row) ? static_cast<int>(it - rows.begin()) : -1;
+  }
+};
+
+void BlockCovarianceBySelectedInversion(ceres::Problem& problem, const std::vector<const double*>& blocks,
+                                        const TangentJacobian& jacobian, const BlockCovarianceOptions& options,
+                                        BlockCovarianceResult* result) {
+  const ceres::CRSMatrix& crs = jacobian.crs;
+  const int n = crs.num_cols;
+  const std::unordered_map<const double*, int> columns = ColumnMap(jacobian);
+  const auto fail_all = [&](const std::string& message) {
+    result->covariances.assign(blocks.size(), std::nullopt);
+    result->message = message;
+  };
+
+  // H = J^T J, plus explicit (zero) entries that make every free block's own square dense,
+  // so that its entries of H^-1 lie on the pattern of the filled matrix L + L^T.
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
+      crs.values.data());
+  Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(J.transpose()) * J;
+  {
+    std::vector<Eigen::Triplet<double>> pattern;
+    for (std::size_t b = 0; b < jacobian.blocks.size(); ++b) {
+      const int size = problem.ParameterBlockTangentSize(jacobian.blocks[b]);
+      for (int r = 0; r < size; ++r) {
+        for (int c = 0; c < size; ++c) pattern.emplace_back(jacobian.offsets[b] + r, jacobian.offsets[b] + c, 0.0);
+      }
+    }
+    Eigen::SparseMatrix<double> P(n, n);
+    P.setFromTriplets(pattern.begin(), pattern.end());
+    H = Eigen::SparseMatrix<double>(H + P);
+  }
+  H.makeCompressed();
+
+  // Jacobi scaling Hs = S H S, S = diag(1 / sqrt(H_ii)): unit diagonal, so the pivots of
+  // its LDL^T lie in (0, 1] and the variance inflation of coordinate i is Zs_ii.
+  Eigen::VectorXd scale(n);
+  for (int i = 0; i < n; ++i) {
+    const double hii = H.coeff(i, i);
+    if (!(hii > 0.0) || !std::isfinite(hii)) {
+      std::ostringstream text;
+      text << "covariance not computable (selected inversion): tangent column " << i
+           << " of the Jacobian is zero or not finite";
+      fail_all(text.str());
+      return;
+    }
+    scale(i) = 1.0 / std::sqrt(hii);
+  }
+  for (int k = 0; k < H.outerSize(); ++k) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(H, k); it; ++it) it.valueRef() *= scale(it.row()) * scale(it.col());
+  }
+
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(H);
+  if (ldlt.info() != Eigen::Success) {
+    fail_all("covariance not computable (selected inversion): the LDL^T factorisation failed (J rank deficient)");
+    return;
+  }
+  // A pivot that is not positive: J^T J is singular (or indefinite by rounding). A tiny
+  // positive one shows as a large variance inflation of the coordinates it touches.
+  const Eigen::VectorXd d = ldlt.vectorD();
+  for (int j = 0; j < n; ++j) {
+    if (!(d(j) > 0.0) || !std::isfinite(d(j))) {
+      std::ostringstream text;
+      text << "covariance not computable (selected inversion): J is rank deficient (LDL^T pivot " << d(j)
+           << " of the Jacobi-scaled J^T J)";
+      fail_all(text.str());
+      return;
+    }
+  }
+  // perm[i]: index in the factored (permuted) matrix of original column i.
+  const Eigen::VectorXi perm = ldlt.permutationP().indices();
+
+  LowerFactor L;
+  {
+    const Eigen::SparseMatrix<double> factor = ldlt.matrixL().nestedExpression();
+    L.start.assign(n + 1, 0);
+    std::vector<std::pair<int, double>> column;
+    for (int j = 0; j < n; ++j) {
+      column.clear();
+      for (Eigen::SparseMatrix<double>::InnerIterator it(factor, j); it; ++it) {
+        if (it.row() > j) column.emplace_back(static_cast<int>(it.row()), it.value());
+      }
+      std::sort(column.begin(), column.end());
+      for (const auto& entry : column) {
+        L.rows.push_back(entry.first);
+        L.values.push_back(entry.second);
+      }
+      L.start[j + 1] = static_cast<int>(L.rows.size());
+    }
+  }
+
+  // Selected inversion, backwards over the columns: Z = Hs^-1 on the pattern of L
+  // (z_offdiag aligned with L's entries) and its diagonal. For column j with rows
+  // r_1 < ... < r_m: every entry Z_{r_a r_b} needed lies in column min(r_a, r_b) of the
+  // pattern (the rows of a column of L form a clique of the filled graph), so iterating
+  // column r_b of Z and keeping the rows marked as belonging to column j finds them all.
+  std::vector<double> z_diag(n, 0.0);
+  std::vector<double> z_offdiag(L.values.size(), 0.0);
+  std::vector<int> position(n, -1);  // position[r] = entry index in column j, -1 if absent
+  for (int j = n - 1; j >= 0; --j) {
+    const int begin = L.start[j], end = L.start[j + 1];
+    for (int a = begin; a < end; ++a) position[L.rows[a]] = a;
+    for (int b = begin; b < end; ++b) {
+      const int c = L.rows[b];
+      const double l_b = L.values[b];
+      z_offdiag[b] -= z_diag[c] * l_b;
+      for (int e = L.start[c]; e < L.start[c + 1]; ++e) {
+        const int a = position[L.rows[e]];
+        if (a < 0) continue;
+        // Z_{r_a c} = Z_{c r_a} with r_a > c: it enters Z_{r_a j} (through l_cj) and Z_{c j}
+        // (through l_{r_a j}).
+        z_offdiag[a] -= z_offdiag[e] * l_b;
+        z_offdiag[b] -= z_offdiag[e] * L.values[a];
+      }
+    }
+    double diag = 1.0 / d(j);
+    for (int a = begin; a < end; ++a) {
+      diag -= L.values[a] * z_offdiag[a];
+      position[L.rows[a]] = -1;
+    }
+    z_diag[j] = diag;
+  }
+  const auto z = [&](int p, int q) -> double {  // Zs in the permuted indices, on the pattern
+    if (p == q) return z_diag[p];
+    const int e = p > q ? L.Find(p, q) : L.Find(q, p);
+    return e >= 0 ? z_offdiag[e] : std::numeric_limits<double>::quiet_NaN();
+  };
+
+  std::vector<Eigen::VectorXd> inflation(blocks.size());
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const int size = problem.ParameterBlockTangentSize(blocks[i]);
+    const auto column = columns.find(blocks[i]);
+    if (column == columns.end()) {  // constant block
+      result->covariances[i] = Eigen::MatrixXd::Zero(size, size);
+      continue;
+    }
+    Eigen::MatrixXd block(size, size);
+    inflation[i].resize(size);
+    for (int r = 0; r < size; ++r) {
+      const int orig_r = column->second + r;
+      for (int c = 0; c <= r; ++c) {
+        const int orig_c = column->second + c;
+        block(r, c) = block(c, r) = scale(orig_r) * scale(orig_c) * z(perm(orig_r), perm(orig_c));
+      }
+      inflation[i](r) = z_diag[perm(orig_r)];
+    }
+    if (!block.allFinite()) {
+      fail_all("covariance not computable (selected inversion): internal error, a block entry is off the "
+               "factor's pattern");
+      return;
+    }
+    result->covariances[i] = block;
+  }
+  RejectInflated(inflation, options.min_reciprocal_condition_number, result);
+}
+
+}  // namespace
+
+BlockCovarianceResult ComputeBlockDiagonalCovariance(ceres::Problem& problem, const std::vector<const double*>& blocks,
+                                                     const BlockCovarianceOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CheckBlocks(problem, blocks);
+  BlockCovarianceResult result;
+  result.covariances.assign(blocks.size(), std::nullopt);
+  TangentJacobian jacobian;
+  if (!EvaluateTangentJacobian(problem, options.num_threads, &jacobian)) {
+    result.message = "covariance not computable: the problem could not be evaluated";
+  } else if (jacobian.blocks.empty()) {  // every block constant
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const int size = problem.ParameterBlockTangentSize(blocks[i]);
+      result.covariances[i] = Eigen::MatrixXd::Zero(size, size);
+    }
+  } else if (options.algorithm == BlockCovarianceOptions::Algorithm::kSparseQr) {
+    BlockCovarianceBySparseQr(problem, blocks, jacobian, options, &result);
+  } else {
+    BlockCovarianceBySelectedInversion(problem, blocks, jacobian, options, &result);
+  }
+  result.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
 }
 
 }  // namespace navtwin

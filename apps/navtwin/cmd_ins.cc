@@ -37,7 +37,7 @@ DEFINE_double(start_s, NAN, "Start time, s (default: the initial record, or the 
 DEFINE_double(end_s, INFINITY, "Stop after this time, s");
 DEFINE_double(output_rate_hz, 0.0, "Solution output rate, Hz (0: every IMU epoch)");
 DEFINE_double(hold_height_m, NAN, "Hold the height at this value (damps the unstable vertical channel)");
-DEFINE_bool(demo, false, "Simulate the built-in 10-min demo flight into --out and navigate it with truth");
+DEFINE_bool(demo, false, "Simulate a built-in demo into --out and run on it with truth (ins: a 10-min flight; navigate, smooth: mems-gps-mag-maneuver)");
 DEFINE_double(demo_rate_hz, 100.0, "IMU rate of the demo flight, Hz");
 DEFINE_double(demo_duration_s, 600.0, "Length of the demo flight, s");
 

@@ -22,6 +22,8 @@ Command ConvertCommand();
 Command InsCommand();
 Command SimulateCommand();
 Command AllanCommand();
+Command NavigateCommand();
+Command SmoothCommand();
 
 /// Exit codes shared by all subcommands.
 constexpr int kExitOk = 0;

@@ -19,7 +19,8 @@ namespace navtwin::app {
 namespace {
 
 std::vector<Command> AllCommands() {
-  return {InfoCommand(), ConvertCommand(), InsCommand(), SimulateCommand(), AllanCommand()};
+  return {InfoCommand(),     ConvertCommand(),  InsCommand(),   SimulateCommand(),
+          AllanCommand(),    NavigateCommand(), SmoothCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {

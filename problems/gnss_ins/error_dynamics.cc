@@ -151,7 +151,7 @@ Eigen::VectorXd ErrorDynamicsQc(const ImuNoise& noise, int n) {
   CheckSize(n, "ErrorDynamicsQc");
   const double inv_tau = InverseTau(noise.correlation_time_s);
   auto gm = [inv_tau](double sigma) { return 2.0 * sigma * sigma * inv_tau; };
-  Eigen::VectorXd q(n);
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(n);  // entries past the noise inputs stay 0
   q.segment<3>(0).setConstant(noise.gyro_arw_rad_per_sqrt_s * noise.gyro_arw_rad_per_sqrt_s);
   q.segment<3>(3).setConstant(noise.accel_vrw_mps_per_sqrt_s * noise.accel_vrw_mps_per_sqrt_s);
   q.segment<3>(6).setConstant(gm(noise.gyro_bias_std_radps));

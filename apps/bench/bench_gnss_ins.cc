@@ -1,0 +1,142 @@
+// GNSS/INS estimator benchmark on the nav-grade-vehicle-1h preset (200 Hz IMU, 1 Hz RTK
+// GNSS, one hour of driving), simulated once into a temporary folder:
+//   Filter/output_hz:10   the error-state filter over the hour, navigation output at 10 Hz
+//                         written to nav.nav, nav.csv, std.csv and imu_errors.csv
+//   Filter/output_hz:0    the same with output at every IMU epoch (200 Hz)
+//   Batch/minutes:N       the full-batch Ceres smoother (started from the filter, with the
+//                         per-state covariance) over the first N = 15, 30, 60 minutes;
+//                         the filter run that starts it is not timed
+// Each case reports peak_rss_MB, the process's peak resident memory after the case: run one
+// case per process for per-case figures, e.g.
+//   <build>/bin/bench_gnss_ins --benchmark_filter='Batch/minutes:30'
+#include <benchmark/benchmark.h>
+
+#include <stdlib.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "core/io/open.h"
+#include "core/sim/simulator.h"
+#include "problems/gnss_ins/batch.h"
+#include "problems/gnss_ins/config.h"
+#include "problems/gnss_ins/filter.h"
+#include "problems/gnss_ins/inputs.h"
+#include "problems/gnss_ins/output.h"
+#include "problems/ins/pure_ins.h"
+
+namespace navtwin::gnss_ins {
+namespace {
+
+constexpr double kDegToRadB = 3.14159265358979323846 / 180.0;
+
+double PeakRss_MB() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+/// The simulated hour, made once per process (removed at exit).
+class NavGradeHour {
+ public:
+  static const NavGradeHour& Get() {
+    static const NavGradeHour instance;
+    return instance;
+  }
+  ~NavGradeHour() { std::filesystem::remove_all(dir_); }
+
+  const std::string& dir() const { return dir_; }
+
+  /// The configuration a user of this IMU would write (the preset's specification values).
+  GnssInsConfig Config(double minutes) const {
+    GnssInsConfig c;
+    const double deg_h = kDegToRadB / 3600.0;
+    c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.002 * kDegToRadB / 60.0;
+    c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.01 / 60.0;
+    c.imu_noise.gyro_bias_std_radps = 0.005 * deg_h;
+    c.imu_noise.accel_bias_std_mps2 = 25e-6 * 9.80665;
+    c.imu_noise.correlation_time_s = 3600.0;
+    c.installation.antenna_lever_arm_b_m = Eigen::Vector3d(0.5, 0.0, -1.5);
+    c.init.source = InitConfig::Source::kGiven;
+    c.init.state = InsState{initial_, ImuErrors{}};
+    c.init.std.pos_ned_m.setConstant(0.05);
+    c.init.std.vel_ned_mps.setConstant(0.01);
+    c.init.std.att_rad.setConstant(0.01 * kDegToRadB);
+    c.end_time_s = initial_.t_s + minutes * 60.0;
+    return c;
+  }
+
+ private:
+  NavGradeHour() {
+    dir_ = (std::filesystem::temp_directory_path() / ("navtwin_bench_gi_" + std::to_string(::getpid()))).string();
+    std::filesystem::create_directories(dir_);
+    std::cerr << "bench_gnss_ins: simulating nav-grade-vehicle-1h into " << dir_ << " ...\n";
+    sim::SimulationOptions options;
+    options.seed = 1;
+    sim::Simulate(sim::LoadScenario("nav-grade-vehicle-1h"), options, dir_);
+    auto init = OpenNav(dir_ + "/init.nav");
+    initial_ = InitialStateFromNav(*init, std::nullopt);
+  }
+
+  std::string dir_;
+  NavState initial_;
+};
+
+InputPaths Paths(const NavGradeHour& hour) {
+  InputPaths paths;
+  paths.imu = hour.dir() + "/imu.txt";
+  paths.gnss = hour.dir() + "/gnss.txt";
+  return paths;
+}
+
+void BM_Filter(benchmark::State& state) {
+  const NavGradeHour& hour = NavGradeHour::Get();
+  GnssInsConfig config = hour.Config(60.0);
+  config.output_rate_hz = static_cast<double>(state.range(0));
+  const Inputs inputs = LoadInputs(Paths(hour), config);
+  const std::string out_dir = hour.dir() + "/filter_out";
+  std::filesystem::create_directories(out_dir);
+  std::size_t outputs = 0;
+  for (auto _ : state) {
+    NavOutputWriter writer(out_dir, config.filter.scale_factors);
+    outputs = 0;
+    const FilterResult result = RunFilter(inputs, config, /*run_rts=*/false,
+                                          [&](const NavEpoch& e) {
+                                            writer.Write(e);
+                                            ++outputs;
+                                          },
+                                          nullptr);
+    writer.Commit();
+    benchmark::DoNotOptimize(result.filter.epochs.size());
+  }
+  state.counters["imu_samples"] = static_cast<double>(inputs.imu.size());
+  state.counters["outputs"] = static_cast<double>(outputs);
+  state.counters["peak_rss_MB"] = PeakRss_MB();
+}
+BENCHMARK(BM_Filter)->ArgName("output_hz")->Arg(10)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1);
+
+void BM_Batch(benchmark::State& state) {
+  const NavGradeHour& hour = NavGradeHour::Get();
+  const GnssInsConfig config = hour.Config(static_cast<double>(state.range(0)));
+  const Inputs inputs = LoadInputs(Paths(hour), config);
+  const FilterResult start = RunFilter(inputs, config, /*run_rts=*/false, {}, nullptr);
+  std::size_t states = 0;
+  for (auto _ : state) {
+    const Solution batch = RunBatch(inputs, config, start.filter, nullptr);
+    states = batch.epochs.size();
+  }
+  state.counters["imu_samples"] = static_cast<double>(inputs.imu.size());
+  state.counters["states"] = static_cast<double>(states);
+  state.counters["peak_rss_MB"] = PeakRss_MB();
+}
+BENCHMARK(BM_Batch)->ArgName("minutes")->Arg(15)->Arg(30)->Arg(60)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+}  // namespace navtwin::gnss_ins
+
+BENCHMARK_MAIN();

@@ -1,0 +1,721 @@
+// RunBatch (problems/gnss_ins/batch.h): the state epochs, the initial values and the
+// preintegrations (one pass over the IMU record), the Ceres problem, the solve with
+// reintegration rounds, and the per-state standard deviations.
+#include "problems/gnss_ins/batch.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+
+#include "core/imu_split.h"
+#include "core/rotation.h"
+#include "core/strapdown.h"
+#include "factors/attitude_manifold.h"
+#include "factors/attitude_prior.h"
+#include "factors/baro_height.h"
+#include "factors/bias_process.h"
+#include "factors/gnss_position.h"
+#include "factors/gnss_velocity.h"
+#include "factors/imu_preintegration.h"
+#include "factors/mag_heading.h"
+#include "factors/mag_vector.h"
+#include "factors/position_manifold.h"
+#include "factors/state_prior.h"
+#include "factors/zero_velocity.h"
+#include "problems/gnss_ins/filter.h"  // InitialStdVector, InitialFilterState, CalibrateMag,
+                                        // MeasurementSigma, StillnessDetector (the filter's rules)
+#include "solvers/batch_driver.h"
+
+namespace navtwin::gnss_ins {
+namespace {
+
+/// Two times closer than this are the same epoch (as in the filter).
+constexpr double kTimeEps_s = 1e-6;
+
+const char* const kGnssPos = "gnss_position";
+const char* const kGnssVel = "gnss_velocity";
+const char* const kMag = "mag";
+const char* const kBaro = "baro";
+const char* const kZupt = "zupt";
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+
+/// A state epoch and, when it is a GNSS epoch, the index of its GNSS sample (-1 if none).
+struct PlannedState {
+  double t_s;
+  long gnss;
+};
+
+struct Plan {
+  std::vector<PlannedState> states;
+  std::size_t gnss_thinned = 0;  ///< GNSS epochs in the span left out by state_interval_s
+  std::size_t gnss_velocity_thinned = 0;  ///< of these, the ones with velocity
+};
+
+Plan PlanStates(const Inputs& inputs, const GnssInsConfig& config, double t0_s, double t_end_s) {
+  const double max_gap = config.batch.max_state_interval_s;
+  if (!(max_gap > 0.0) || !std::isfinite(max_gap)) {
+    throw std::invalid_argument("RunBatch: batch.max_state_interval_s must be positive and finite");
+  }
+  const double thin = config.batch.state_interval_s;
+  Plan plan;
+  std::vector<PlannedState> anchors{{t0_s, -1}};
+  for (std::size_t i = 0; i < inputs.gnss.size(); ++i) {
+    const double t = inputs.gnss[i].t_s;
+    if (t < t0_s - kTimeEps_s) continue;
+    if (t > t_end_s + kTimeEps_s) break;
+    if (t <= t0_s + kTimeEps_s) {  // at the first state
+      anchors.front().gnss = static_cast<long>(i);
+      continue;
+    }
+    if (thin > 0.0 && t - anchors.back().t_s < thin - kTimeEps_s) {
+      ++plan.gnss_thinned;
+      plan.gnss_velocity_thinned += inputs.gnss[i].has_velocity ? 1 : 0;
+      continue;
+    }
+    anchors.push_back({t, static_cast<long>(i)});
+  }
+  if (t_end_s - anchors.back().t_s > max_gap + kTimeEps_s) anchors.push_back({t_end_s, -1});
+  for (std::size_t i = 0; i < anchors.size(); ++i) {
+    plan.states.push_back(anchors[i]);
+    if (i + 1 == anchors.size()) break;
+    const double gap = anchors[i + 1].t_s - anchors[i].t_s;
+    const int pieces = static_cast<int>(std::ceil(gap / max_gap - 1e-9));
+    for (int k = 1; k < pieces; ++k) plan.states.push_back({anchors[i].t_s + k * gap / pieces, -1});
+  }
+  return plan;
+}
+
+/// The parameter blocks and the initial information of one state.
+struct BatchState {
+  double t_s = 0.0;
+  long gnss = -1;
+  std::array<double, 3> pos{};  ///< lat_rad, lon_rad, h_m
+  std::array<double, 3> vel{};  ///< v_n_mps
+  std::array<double, 4> q{};    ///< q_n_b x, y, z, w
+  std::array<double, 3> bg{};   ///< own gyro bias block (unused when shared)
+  std::array<double, 3> ba{};
+  double* bg_block = nullptr;   ///< the gyro bias block of this state (own or shared)
+  double* ba_block = nullptr;
+  InsState initial;             ///< mechanized from the start solution (scale factors used)
+  Eigen::Vector3d omega_ib_b_radps = Eigen::Vector3d::Zero();  ///< bias-corrected, at t_s
+  bool still = false;           ///< the stillness rule holds at t_s
+};
+
+/// R_{b(a) b(b)} for a <= b: the body rotation over [a, b] as the product of Exp of the
+/// bias-corrected gyro increments (pieces of samples pro rata), v_{b(a)} = R v_{b(b)}. The
+/// rotation of the navigation frame over |b - a| <= kMaxSensorAssociation_s (< 4e-5 rad)
+/// is left out.
+Eigen::Quaterniond BodyRotation(const std::vector<ImuSample>& imu, double a, double b, const ImuErrors& e) {
+  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+  auto it = std::upper_bound(imu.begin(), imu.end(), a + kTimeEps_s,
+                             [](double t, const ImuSample& s) { return t < s.t_s; });
+  for (; it != imu.end() && it->t_s - it->dt_s < b - kTimeEps_s; ++it) {
+    const double lo = std::max(it->t_s - it->dt_s, a);
+    const double hi = std::min(it->t_s, b);
+    if (hi <= lo) continue;
+    const ImuSample c = CorrectImu(*it, e);
+    q = q * QuatFromRotVec<double>(c.dtheta_b_rad * ((hi - lo) / it->dt_s));
+  }
+  return q.normalized();
+}
+
+/// For every state, the index of the sample nearest in time among those whose nearest
+/// state it is (each sample used at most once), within kMaxSensorAssociation_s; -1 if none.
+template <typename Sample>
+std::vector<long> AssociateNearest(const std::vector<Sample>& samples, const std::vector<BatchState>& states) {
+  std::vector<long> best(states.size(), -1);
+  std::vector<double> best_dt(states.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> times(states.size());
+  for (std::size_t i = 0; i < states.size(); ++i) times[i] = states[i].t_s;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const double t = samples[k].t_s;
+    const auto it = std::lower_bound(times.begin(), times.end(), t);
+    std::size_t j = static_cast<std::size_t>(it - times.begin());
+    if (j == times.size() || (j > 0 && t - times[j - 1] < times[j] - t)) --j;
+    const double dt = std::abs(t - times[j]);
+    if (dt <= kMaxSensorAssociation_s && dt < best_dt[j]) {
+      best_dt[j] = dt;
+      best[j] = static_cast<long>(k);
+    }
+  }
+  return best;
+}
+
+/// How a bias (gyro or accelerometer) is modelled.
+struct BiasModel {
+  bool shared = false;     ///< one block for all states (no process noise)
+  bool constant = false;   ///< shared and held (zero initial std)
+  double steady_std = 0.0; ///< Gauss-Markov steady-state std (per-state blocks)
+  double tau_s = 0.0;
+  Eigen::Vector3d prior_std = Eigen::Vector3d::Zero();
+};
+
+BiasModel MakeBiasModel(double steady_std, double tau_s, const Eigen::Vector3d& initial_std, double tiny) {
+  BiasModel m;
+  m.steady_std = steady_std;
+  m.tau_s = tau_s;
+  m.shared = !(steady_std > 0.0 && tau_s > 0.0 && std::isfinite(tau_s));
+  m.constant = m.shared && (initial_std.array() <= 0.0).all();
+  m.prior_std = initial_std.cwiseMax(tiny);
+  return m;
+}
+
+class BatchSmoother {
+ public:
+  BatchSmoother(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, std::ostream* progress)
+      : in_(inputs), cfg_(config), start_(start), progress_(progress) {}
+
+  Solution Run();
+
+ private:
+  void Check() const;
+  void Initialise(const Plan& plan);
+  void MechanizeAndPreintegrate();
+  void BuildProblem();
+  void AddImuFactor(std::size_t i);
+  void AddGnss();
+  void AddMag();
+  void AddBaro();
+  void AddZupt();
+  void AddPriors();
+  int Reintegrate();
+  void Covariance(Solution* solution, std::ostringstream* report);
+  void Say(const std::string& line) const {
+    if (progress_ != nullptr) *progress_ << "batch: " << line << '\n' << std::flush;
+  }
+
+  const Inputs& in_;
+  const GnssInsConfig& cfg_;
+  const Solution& start_;
+  std::ostream* progress_;
+
+  BiasModel gyro_model_, accel_model_;
+  std::array<double, 3> shared_bg_{}, shared_ba_{};
+  std::vector<BatchState> states_;
+  std::vector<std::shared_ptr<ImuPreintegration>> pre_;  ///< interval i: states i -> i + 1
+  std::vector<ceres::ResidualBlockId> imu_factors_;
+  std::map<std::string, MeasurementCount> counts_;
+  std::size_t imu_samples_ = 0;
+
+  // Declared before the problem, which does not own them (shared by many blocks).
+  PositionManifold position_manifold_;
+  AttitudeManifold attitude_manifold_;
+  std::unique_ptr<ceres::LossFunction> huber_;
+  std::unique_ptr<ceres::Problem> problem_;
+};
+
+void BatchSmoother::Check() const {
+  if (start_.epochs.empty()) throw std::invalid_argument("RunBatch: the start solution has no epoch");
+  for (std::size_t i = 1; i < start_.epochs.size(); ++i) {
+    if (!(start_.epochs[i].state.nav.t_s > start_.epochs[i - 1].state.nav.t_s)) {
+      throw std::invalid_argument("RunBatch: the start solution's epochs are not increasing in time");
+    }
+  }
+  if (in_.imu.empty()) throw std::invalid_argument("RunBatch: no IMU samples");
+  const double t0 = start_.epochs.front().state.nav.t_s;
+  const double imu_begin = in_.imu.front().t_s - in_.imu.front().dt_s;
+  if (t0 < imu_begin - kTimeEps_s || t0 >= in_.imu.back().t_s - kTimeEps_s) {
+    std::ostringstream text;
+    text.precision(12);
+    text << "RunBatch: the start solution begins at t = " << t0 << " s, outside the IMU record [" << imu_begin
+         << ", " << in_.imu.back().t_s << "] s";
+    throw std::invalid_argument(text.str());
+  }
+  const ImuNoise& n = cfg_.imu_noise;
+  if (!(n.gyro_arw_rad_per_sqrt_s > 0.0) || !(n.accel_vrw_mps_per_sqrt_s > 0.0)) {
+    throw std::invalid_argument("RunBatch: the IMU preintegration needs a positive gyro ARW and accelerometer VRW");
+  }
+  if (cfg_.mag.mode == MagConfig::Mode::kVector && cfg_.mag.field_ned_uT.isZero(0.0)) {
+    throw std::invalid_argument("RunBatch: magnetometer mode vector needs mag.field_ned_uT");
+  }
+}
+
+void BatchSmoother::Initialise(const Plan& plan) {
+  const Eigen::VectorXd init_std = InitialStdVector(cfg_, err::kSize15);
+  const ImuNoise& n = cfg_.imu_noise;
+  gyro_model_ = MakeBiasModel(n.gyro_bias_std_radps, n.correlation_time_s, init_std.segment<3>(err::kBg), 1e-12);
+  accel_model_ = MakeBiasModel(n.accel_bias_std_mps2, n.correlation_time_s, init_std.segment<3>(err::kBa), 1e-10);
+  states_.resize(plan.states.size());
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    states_[i].t_s = plan.states[i].t_s;
+    states_[i].gnss = plan.states[i].gnss;
+    states_[i].bg_block = gyro_model_.shared ? shared_bg_.data() : states_[i].bg.data();
+    states_[i].ba_block = accel_model_.shared ? shared_ba_.data() : states_[i].ba.data();
+  }
+  for (const char* key : {kGnssPos, kGnssVel, kMag, kBaro, kZupt}) counts_[key];
+  counts_[kGnssPos].rejected += plan.gnss_thinned;
+  if (cfg_.gnss.use_velocity) counts_[kGnssVel].rejected += plan.gnss_velocity_thinned;
+}
+
+/// One pass over the IMU record: the strapdown mechanization from the latest knot of the
+/// start solution (reset at every knot, with that knot's IMU errors) gives each state's
+/// initial value; the same pieces of samples, split at the state (and knot) times and
+/// corrected for the scale factors of the interval's first state, go into that interval's
+/// preintegration, linearised at the first state's bias blocks' initial values.
+void BatchSmoother::MechanizeAndPreintegrate() {
+  const std::vector<NavEpoch>& knots = start_.epochs;
+  const std::vector<ImuSample>& imu = in_.imu;
+  const std::size_t n = states_.size();
+  const double t0 = states_.front().t_s;
+  const ImuNoise& noise = cfg_.imu_noise;
+
+  Strapdown strapdown(knots.front().state.nav);
+  ImuErrors errors = knots.front().state.imu;
+  std::size_t kn = 1, si = 0;
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();
+  StillnessDetector detector(cfg_.zupt);
+  ImuErrors scale;  // the scale factors of the current interval (biases zero)
+
+  // The bias blocks' initial values: each state's from its knot, shared ones from the first.
+  const auto record_state = [&]() {
+    BatchState& s = states_[si];
+    s.initial.nav = strapdown.state();
+    s.initial.nav.t_s = s.t_s;
+    s.initial.imu = errors;
+    s.omega_ib_b_radps = omega;
+    s.still = cfg_.zupt.enabled && detector.Still();
+    const NavState& nav = s.initial.nav;
+    s.pos = {nav.lat_rad, nav.lon_rad, nav.h_m};
+    s.vel = {nav.v_n_mps.x(), nav.v_n_mps.y(), nav.v_n_mps.z()};
+    const Eigen::Quaterniond q = nav.q_n_b.normalized();
+    s.q = {q.x(), q.y(), q.z(), q.w()};
+    for (int k = 0; k < 3; ++k) {
+      s.bg[k] = errors.bg_radps[k];
+      s.ba[k] = errors.ba_mps2[k];
+    }
+    if (si == 0) {
+      for (int k = 0; k < 3; ++k) {
+        shared_bg_[k] = errors.bg_radps[k];
+        shared_ba_[k] = errors.ba_mps2[k];
+      }
+    }
+    if (si + 1 < n) {
+      const Eigen::Vector3d bg_lin = Eigen::Map<const Eigen::Vector3d>(s.bg_block);
+      const Eigen::Vector3d ba_lin = Eigen::Map<const Eigen::Vector3d>(s.ba_block);
+      pre_[si] = std::make_shared<ImuPreintegration>(bg_lin, ba_lin, noise.gyro_arw_rad_per_sqrt_s,
+                                                     noise.accel_vrw_mps_per_sqrt_s);
+      scale = ImuErrors{};
+      scale.sg = errors.sg;
+      scale.sa = errors.sa;
+    }
+    ++si;
+  };
+  const auto events = [&](double t) {
+    while (kn < knots.size() && knots[kn].state.nav.t_s <= t + kTimeEps_s) {
+      NavState nav = knots[kn].state.nav;
+      nav.t_s = strapdown.state().t_s;
+      strapdown.SetState(nav);
+      errors = knots[kn].state.imu;
+      ++kn;
+    }
+    while (si < n && states_[si].t_s <= t + kTimeEps_s) record_state();
+  };
+  const auto step = [&](const ImuSample& piece) {
+    const ImuSample c = CorrectImu(piece, errors);
+    strapdown.Update(c);
+    omega = c.dtheta_b_rad / c.dt_s;
+    pre_[si - 1]->Integrate(CorrectImu(piece, scale));
+    ++imu_samples_;
+  };
+
+  pre_.assign(n > 0 ? n - 1 : 0, nullptr);
+  // The angular rate at t0: of the sample that ends at or contains t0.
+  auto k = std::lower_bound(imu.begin(), imu.end(), t0 - kTimeEps_s,
+                            [](const ImuSample& s, double t) { return s.t_s < t; });
+  if (k != imu.end()) omega = CorrectImu(*k, errors).dtheta_b_rad / k->dt_s;
+  // Samples ending at or before t0 only feed the stillness window.
+  for (auto w = imu.begin(); w != imu.end() && w->t_s <= t0 + kTimeEps_s; ++w) {
+    if (cfg_.zupt.enabled && w->t_s > t0 - cfg_.zupt.window_s - 1.0) detector.Add(CorrectImu(*w, errors));
+  }
+  record_state();
+  k = std::upper_bound(imu.begin(), imu.end(), t0 + kTimeEps_s,
+                       [](double t, const ImuSample& s) { return t < s.t_s; });
+  for (; k != imu.end() && si < n; ++k) {
+    ImuSample piece = *k;
+    if (piece.t_s - piece.dt_s < t0 - kTimeEps_s) piece = SplitImuSample(piece, t0).second;
+    while (true) {
+      const double next_knot = kn < knots.size() ? knots[kn].state.nav.t_s : INFINITY;
+      const double next = std::min(next_knot, states_[si].t_s);
+      if (next >= piece.t_s - kTimeEps_s) break;
+      if (next > piece.t_s - piece.dt_s + kTimeEps_s) {
+        const std::pair<ImuSample, ImuSample> parts = SplitImuSample(piece, next);
+        step(parts.first);
+        piece = parts.second;
+      }
+      events(next);
+      if (si >= n) break;
+    }
+    if (si >= n) break;
+    step(piece);
+    if (cfg_.zupt.enabled) detector.Add(CorrectImu(*k, errors));
+    events(piece.t_s);
+  }
+  if (si < n) {
+    std::ostringstream text;
+    text.precision(12);
+    text << "RunBatch: internal error, state at t = " << states_[si].t_s << " s beyond the IMU record";
+    throw std::logic_error(text.str());
+  }
+}
+
+void BatchSmoother::AddImuFactor(std::size_t i) {
+  BatchState& a = states_[i];
+  BatchState& b = states_[i + 1];
+  imu_factors_[i] = problem_->AddResidualBlock(CreateImuFactor(pre_[i]), nullptr,
+                                               {a.pos.data(), a.vel.data(), a.q.data(), a.bg_block, a.ba_block,
+                                                b.pos.data(), b.vel.data(), b.q.data()});
+}
+
+void BatchSmoother::AddGnss() {
+  const Eigen::Vector3d& lever = cfg_.installation.antenna_lever_arm_b_m;
+  for (BatchState& s : states_) {
+    if (s.gnss < 0) continue;
+    const GnssSample& g = in_.gnss[static_cast<std::size_t>(s.gnss)];
+    const Eigen::Vector3d sp = MeasurementSigma(g.pos_std_ned_m, cfg_.gnss.pos_std_floor_m, cfg_.gnss.default_pos_std_m);
+    problem_->AddResidualBlock(GnssPosition::Create(Eigen::Vector3d(g.lat_rad, g.lon_rad, g.h_m), lever, sp),
+                               huber_.get(), s.pos.data(), s.q.data());
+    ++counts_[kGnssPos].used;
+    if (cfg_.gnss.use_velocity && g.has_velocity) {
+      const Eigen::Vector3d sv =
+          MeasurementSigma(g.vel_std_ned_mps, cfg_.gnss.vel_std_floor_mps, cfg_.gnss.default_vel_std_mps);
+      problem_->AddResidualBlock(GnssVelocity::Create(g.v_n_mps, lever, s.omega_ib_b_radps, sv), huber_.get(),
+                                 s.vel.data(), s.q.data());
+      ++counts_[kGnssVel].used;
+    }
+  }
+}
+
+void BatchSmoother::AddMag() {
+  const MagConfig& mc = cfg_.mag;
+  if (mc.mode == MagConfig::Mode::kOff || in_.mag.empty()) return;
+  const std::vector<long> nearest = AssociateNearest(in_.mag, states_);
+  double last_used_s = -INFINITY;
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    if (nearest[i] < 0) continue;
+    BatchState& s = states_[i];
+    const MagSample& sample = in_.mag[static_cast<std::size_t>(nearest[i])];
+    if (sample.t_s - last_used_s < mc.min_interval_s - kTimeEps_s) continue;
+    // The calibrated field in the body axes at the state epoch.
+    const Eigen::Vector3d m_sample = CalibrateMag(sample.m_b_uT, mc);
+    Eigen::Vector3d m = m_sample;
+    if (sample.t_s > s.t_s) {
+      m = BodyRotation(in_.imu, s.t_s, sample.t_s, s.initial.imu) * m_sample;
+    } else if (sample.t_s < s.t_s) {
+      m = BodyRotation(in_.imu, sample.t_s, s.t_s, s.initial.imu).conjugate() * m_sample;
+    }
+    if (!m.allFinite()) {
+      ++counts_[kMag].rejected;
+      continue;
+    }
+    ceres::CostFunction* cost = nullptr;
+    switch (mc.mode) {
+      case MagConfig::Mode::kVector:
+        cost = MagVector::Create(m, mc.field_ned_uT, mc.noise_uT);
+        break;
+      case MagConfig::Mode::kHeading:
+        cost = MagHeading::Create(m, mc.declination_rad, mc.heading_std_rad);
+        break;
+      case MagConfig::Mode::kHeading2Axis: {
+        const Eigen::Vector3d rpy = EulerFromQuat<double>(s.initial.nav.q_n_b);
+        if (!(std::abs(rpy[0]) < mc.max_tilt_rad && std::abs(rpy[1]) < mc.max_tilt_rad)) {
+          ++counts_[kMag].rejected;  // tilted: the 2-axis compass is not used
+          continue;
+        }
+        cost = MagHeading2Axis::Create(m.x(), m.y(), mc.declination_rad, mc.heading_std_rad);
+        break;
+      }
+      case MagConfig::Mode::kOff:
+        return;
+    }
+    problem_->AddResidualBlock(cost, nullptr, s.q.data());
+    last_used_s = sample.t_s;
+    ++counts_[kMag].used;
+  }
+}
+
+void BatchSmoother::AddBaro() {
+  if (!cfg_.baro.use || in_.baro.empty()) return;
+  // The offset altitude - height, at the first usable sample at or after the first GNSS
+  // epoch of the states (or the first state without GNSS), with the initial height
+  // interpolated between the states around it.
+  double from_s = states_.front().t_s;
+  for (const BatchState& s : states_) {
+    if (s.gnss >= 0) {
+      from_s = s.t_s;
+      break;
+    }
+  }
+  std::optional<double> offset_m;
+  double offset_t_s = 0.0;
+  for (const BaroSample& b : in_.baro) {
+    if (b.t_s < from_s - kTimeEps_s || !std::isfinite(b.altitude_m)) continue;
+    if (b.t_s > states_.back().t_s + kTimeEps_s) break;
+    auto it = std::upper_bound(states_.begin(), states_.end(), b.t_s,
+                               [](double t, const BatchState& s) { return t < s.t_s; });
+    const BatchState& hi = it == states_.end() ? states_.back() : *it;
+    const BatchState& lo = it == states_.begin() ? states_.front() : *(it - 1);
+    const double span = hi.t_s - lo.t_s;
+    const double a = span > 0.0 ? (b.t_s - lo.t_s) / span : 0.0;
+    const double h = (1.0 - a) * lo.initial.nav.h_m + a * hi.initial.nav.h_m;
+    offset_m = b.altitude_m - h;
+    offset_t_s = b.t_s;
+    break;
+  }
+  const std::vector<long> nearest = AssociateNearest(in_.baro, states_);
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    if (nearest[i] < 0) continue;
+    BatchState& s = states_[i];
+    const BaroSample& b = in_.baro[static_cast<std::size_t>(nearest[i])];
+    if (!offset_m || b.t_s < offset_t_s - kTimeEps_s || !std::isfinite(b.altitude_m)) {
+      ++counts_[kBaro].rejected;
+      continue;
+    }
+    // Carried to the state time with the initial vertical velocity: dh/dt = -v_d.
+    const double h_m = b.altitude_m - *offset_m - s.initial.nav.v_n_mps.z() * (s.t_s - b.t_s);
+    problem_->AddResidualBlock(BaroHeight::Create(h_m, cfg_.baro.std_m), nullptr, s.pos.data());
+    ++counts_[kBaro].used;
+  }
+}
+
+void BatchSmoother::AddZupt() {
+  if (!cfg_.zupt.enabled) return;
+  for (BatchState& s : states_) {
+    if (!s.still) continue;
+    problem_->AddResidualBlock(ZeroVelocity::Create(cfg_.zupt.std_mps), nullptr, s.vel.data());
+    ++counts_[kZupt].used;
+  }
+}
+
+void BatchSmoother::AddPriors() {
+  // Centred on the filter's initial state when it starts at the first state's time (the
+  // prior the filter used), else on the first knot.
+  InsState centre = start_.epochs.front().state;
+  try {
+    const FilterStart fs = InitialFilterState(in_, cfg_);
+    if (std::abs(fs.state.nav.t_s - states_.front().t_s) <= kTimeEps_s) centre = fs.state;
+  } catch (const std::exception&) {
+    // No initial state from the configuration: the first knot.
+  }
+  const Eigen::VectorXd std = InitialStdVector(cfg_, err::kSize15);
+  BatchState& s = states_.front();
+  const NavState& c = centre.nav;
+  problem_->AddResidualBlock(
+      PositionPrior::Create(Eigen::Vector3d(c.lat_rad, c.lon_rad, c.h_m), std.segment<3>(err::kPos).cwiseMax(1e-6)),
+      nullptr, s.pos.data());
+  problem_->AddResidualBlock(VectorPrior3::Create(c.v_n_mps, std.segment<3>(err::kVel).cwiseMax(1e-6)), nullptr,
+                             s.vel.data());
+  const Eigen::Vector3d att_std = std.segment<3>(err::kAtt).cwiseMax(1e-8);
+  problem_->AddResidualBlock(AttitudePrior::Create(c.q_n_b, Eigen::Matrix3d(att_std.cwiseInverse().asDiagonal())), nullptr,
+                             s.q.data());
+  if (!gyro_model_.constant) {
+    problem_->AddResidualBlock(VectorPrior3::Create(centre.imu.bg_radps, gyro_model_.prior_std), nullptr, s.bg_block);
+  }
+  if (!accel_model_.constant) {
+    problem_->AddResidualBlock(VectorPrior3::Create(centre.imu.ba_mps2, accel_model_.prior_std), nullptr,
+                               s.ba_block);
+  }
+}
+
+void BatchSmoother::BuildProblem() {
+  ceres::Problem::Options options;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.enable_fast_removal = true;  // reintegration replaces IMU factors
+  problem_ = std::make_unique<ceres::Problem>(options);
+  if (cfg_.batch.huber_k > 0.0) huber_ = std::make_unique<ceres::HuberLoss>(cfg_.batch.huber_k);
+
+  for (BatchState& s : states_) {
+    problem_->AddParameterBlock(s.pos.data(), 3, &position_manifold_);
+    problem_->AddParameterBlock(s.vel.data(), 3);
+    problem_->AddParameterBlock(s.q.data(), 4, &attitude_manifold_);
+    if (!gyro_model_.shared || &s == &states_.front()) problem_->AddParameterBlock(s.bg_block, 3);
+    if (!accel_model_.shared || &s == &states_.front()) problem_->AddParameterBlock(s.ba_block, 3);
+  }
+  if (gyro_model_.constant) problem_->SetParameterBlockConstant(shared_bg_.data());
+  if (accel_model_.constant) problem_->SetParameterBlockConstant(shared_ba_.data());
+
+  imu_factors_.assign(pre_.size(), nullptr);
+  for (std::size_t i = 0; i + 1 < states_.size(); ++i) {
+    AddImuFactor(i);
+    const double dt = states_[i + 1].t_s - states_[i].t_s;
+    if (!gyro_model_.shared) {
+      problem_->AddResidualBlock(BiasGaussMarkov::Create(dt, gyro_model_.tau_s, gyro_model_.steady_std), nullptr,
+                                 states_[i].bg_block, states_[i + 1].bg_block);
+    }
+    if (!accel_model_.shared) {
+      problem_->AddResidualBlock(BiasGaussMarkov::Create(dt, accel_model_.tau_s, accel_model_.steady_std), nullptr,
+                                 states_[i].ba_block, states_[i + 1].ba_block);
+    }
+  }
+  AddGnss();
+  AddMag();
+  AddBaro();
+  AddZupt();
+  AddPriors();
+}
+
+/// Reintegrates the intervals whose gyro bias moved too far from the linearisation point
+/// and replaces their factors; returns how many.
+int BatchSmoother::Reintegrate() {
+  const double arw = cfg_.imu_noise.gyro_arw_rad_per_sqrt_s;
+  const double fixed = cfg_.batch.relinearize_bias_radps;
+  int count = 0;
+  for (std::size_t i = 0; i < pre_.size(); ++i) {
+    ImuPreintegration& pre = *pre_[i];
+    const Eigen::Vector3d bg = Eigen::Map<const Eigen::Vector3d>(states_[i].bg_block);
+    const Eigen::Vector3d ba = Eigen::Map<const Eigen::Vector3d>(states_[i].ba_block);
+    const double moved = (bg - pre.bg_lin_radps()).norm();
+    const double dt = pre.dt_s();
+    const bool too_far = fixed > 0.0 ? moved > fixed : moved * dt > 0.1 * arw * std::sqrt(dt);
+    if (!too_far) continue;
+    pre.Reintegrate(bg, ba);
+    problem_->RemoveResidualBlock(imu_factors_[i]);
+    AddImuFactor(i);
+    ++count;
+  }
+  return count;
+}
+
+void BatchSmoother::Covariance(Solution* solution, std::ostringstream* report) {
+  std::vector<const double*> blocks;
+  std::set<const double*> seen;
+  for (const BatchState& s : states_) {
+    for (const double* b : {static_cast<const double*>(s.pos.data()), static_cast<const double*>(s.vel.data()),
+                            static_cast<const double*>(s.q.data()), static_cast<const double*>(s.bg_block),
+                            static_cast<const double*>(s.ba_block)}) {
+      if (seen.insert(b).second) blocks.push_back(b);
+    }
+  }
+  BlockCovarianceOptions options;
+  options.num_threads = std::max(1, cfg_.batch.threads);
+  const BlockCovarianceResult result = ComputeBlockDiagonalCovariance(*problem_, blocks, options);
+  std::map<const double*, Eigen::VectorXd> stds;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const int size = problem_->ParameterBlockTangentSize(blocks[i]);
+    stds[blocks[i]] = result.covariances[i]
+                          ? Eigen::VectorXd(result.covariances[i]->diagonal().cwiseMax(0.0).cwiseSqrt())
+                          : Eigen::VectorXd::Constant(size, std::numeric_limits<double>::quiet_NaN());
+  }
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    const BatchState& s = states_[i];
+    Eigen::VectorXd& std = solution->epochs[i].std;
+    std.resize(err::kSize15);
+    std.segment<3>(err::kPos) = stds[s.pos.data()];
+    std.segment<3>(err::kVel) = stds[s.vel.data()];
+    std.segment<3>(err::kAtt) = stds[s.q.data()];
+    std.segment<3>(err::kBg) = stds[s.bg_block];
+    std.segment<3>(err::kBa) = stds[s.ba_block];
+  }
+  std::ostringstream line;
+  line.precision(3);
+  line << "covariance: " << blocks.size() << " blocks by selected inversion in " << result.run_time_s << " s";
+  if (!result.message.empty()) line << "; " << result.message << " (their std are NaN)";
+  *report << line.str() << '\n';
+  Say(line.str());
+}
+
+Solution BatchSmoother::Run() {
+  const auto wall_start = std::chrono::steady_clock::now();
+  Check();
+  const double t0 = start_.epochs.front().state.nav.t_s;
+  const Plan plan = PlanStates(in_, cfg_, t0, in_.imu.back().t_s);
+  Initialise(plan);
+  MechanizeAndPreintegrate();
+  BuildProblem();
+  {
+    std::ostringstream line;
+    line.precision(3);
+    line << states_.size() << " states, " << imu_samples_ << " IMU pieces preintegrated, "
+         << counts_[kGnssPos].used << " GNSS positions, " << counts_[kGnssVel].used << " velocities, "
+         << counts_[kMag].used << " mag, " << counts_[kBaro].used << " baro, " << counts_[kZupt].used
+         << " ZUPT; setup " << Seconds(wall_start) << " s";
+    Say(line.str());
+  }
+
+  BatchOptions options;
+  options.max_iterations = cfg_.batch.max_iterations;
+  options.num_threads = std::max(1, cfg_.batch.threads);
+  options.linear_solver = BatchOptions::LinearSolver::kSparseNormalCholesky;
+  options.function_tolerance = 1e-8;  // |cost change| / cost: far below one unit of chi-square
+  options.progress = progress_ != nullptr;
+  std::ostringstream report;
+  BatchReport solve = SolveBatch(*problem_, options, progress_);
+  report << "solve 1: " << solve.brief_report << '\n';
+  for (int round = 1; round <= kMaxReintegrationRounds; ++round) {
+    const int reintegrated = Reintegrate();
+    if (reintegrated == 0) break;
+    std::ostringstream line;
+    line << "reintegration round " << round << ": " << reintegrated << " of " << pre_.size()
+         << " intervals (gyro bias moved past the threshold)";
+    report << line.str() << '\n';
+    Say(line.str());
+    solve = SolveBatch(*problem_, options, progress_);
+    report << "solve " << round + 1 << ": " << solve.brief_report << '\n';
+  }
+
+  Solution solution;
+  solution.method = "batch";
+  solution.epochs.resize(states_.size());
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    const BatchState& s = states_[i];
+    InsState& x = solution.epochs[i].state;
+    x.nav.t_s = s.t_s;
+    x.nav.gps_week = start_.epochs.front().state.nav.gps_week;
+    x.nav.lat_rad = s.pos[0];
+    x.nav.lon_rad = s.pos[1];
+    x.nav.h_m = s.pos[2];
+    x.nav.v_n_mps = Eigen::Vector3d(s.vel[0], s.vel[1], s.vel[2]);
+    x.nav.q_n_b = Eigen::Quaterniond(s.q[3], s.q[0], s.q[1], s.q[2]).normalized();
+    x.imu = s.initial.imu;  // scale factors as used
+    x.imu.bg_radps = Eigen::Map<const Eigen::Vector3d>(s.bg_block);
+    x.imu.ba_mps2 = Eigen::Map<const Eigen::Vector3d>(s.ba_block);
+  }
+  if (cfg_.batch.covariance) Covariance(&solution, &report);
+  solution.counts = counts_;
+  solution.solver_report = report.str();
+  if (!solution.solver_report.empty() && solution.solver_report.back() == '\n') solution.solver_report.pop_back();
+  solution.run_time_s = Seconds(wall_start);
+  {
+    std::ostringstream line;
+    line.precision(3);
+    line << "done in " << solution.run_time_s << " s";
+    Say(line.str());
+  }
+  return solution;
+}
+
+}  // namespace
+
+std::vector<double> BatchStateTimes(const Inputs& inputs, const GnssInsConfig& config, double t0_s, double t_end_s) {
+  const Plan plan = PlanStates(inputs, config, t0_s, t_end_s);
+  std::vector<double> times;
+  times.reserve(plan.states.size());
+  for (const PlannedState& s : plan.states) times.push_back(s.t_s);
+  return times;
+}
+
+Solution RunBatch(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, std::ostream* progress) {
+  BatchSmoother smoother(inputs, config, start, progress);
+  return smoother.Run();
+}
+
+}  // namespace navtwin::gnss_ins

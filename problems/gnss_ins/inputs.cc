@@ -1,0 +1,240 @@
+// LoadInputs (inputs.h): reads the IMU, GNSS, magnetometer and barometer records, applies
+// the installation, cuts to the configured time span, bridges short IMU gaps, injects the
+// scoring outages and checks what the estimators rely on (docs/gnss-ins.md "Bad input").
+#include "problems/gnss_ins/ins_state.h"  // before inputs.h: config.h uses InsState
+#include "problems/gnss_ins/inputs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/io/input_error.h"
+#include "core/io/open.h"
+#include "core/rotation.h"
+
+namespace navtwin::gnss_ins {
+namespace {
+
+/// Tolerance on time comparisons at the cut points (time tags are often printed with
+/// microsecond resolution).
+constexpr double kTimeTol_s = 1e-6;
+/// An interval longer than this many nominal intervals is a gap.
+constexpr double kGapFactor = 1.5;
+
+std::string Num(double x) {
+  std::ostringstream s;
+  s.precision(12);
+  s << x;
+  return s.str();
+}
+
+void RequireFinite(bool ok, const std::string& file, const std::string& field, double t_s) {
+  if (!ok) throw InputError(file, 0, field, "not a finite number (sample at t = " + Num(t_s) + " s)");
+}
+
+/// Median of the sample intervals (the nominal interval; robust to gaps and jitter).
+double MedianInterval(const std::vector<ImuSample>& imu) {
+  std::vector<double> dt;
+  dt.reserve(imu.size());
+  for (const ImuSample& s : imu) dt.push_back(s.dt_s);
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  return dt[dt.size() / 2];
+}
+
+/// Barometric altitude from pressure in the ISA troposphere (ISO 2533):
+/// h = T0/L (1 - (p/p0)^(1/5.255877)), T0 = 288.15 K, L = 0.0065 K/m, p0 = 101325 Pa.
+/// Only height differences matter (the offset to the ellipsoid is estimated).
+double IsaAltitude_m(double pressure_pa) {
+  return 288.15 / 0.0065 * (1.0 - std::pow(pressure_pa / 101325.0, 1.0 / 5.255877));
+}
+
+std::vector<ImuSample> ReadImu(const std::string& path, const GnssInsConfig& config) {
+  const Installation& inst = config.installation;
+  const Eigen::Vector3d& rpy = inst.imu_mounting_rpy_rad;
+  // v_b = R_b_imu v_imu (config.h, Installation).
+  const Eigen::Matrix3d R_b_imu = DcmFromEuler(rpy[0], rpy[1], rpy[2]);
+  auto reader = OpenImu(path);
+  std::vector<ImuSample> out;
+  ImuSample s;
+  while (reader->Next(&s)) {
+    RequireFinite(std::isfinite(s.t_s) && std::isfinite(s.dt_s), path, "time", s.t_s);
+    RequireFinite(s.dtheta_b_rad.allFinite(), path, "dtheta", s.t_s);
+    RequireFinite(s.dv_b_mps.allFinite(), path, "dv", s.t_s);
+    s.t_s += inst.imu_time_offset_s;
+    if (s.t_s - s.dt_s < config.start_time_s - kTimeTol_s) continue;
+    if (s.t_s > config.end_time_s + kTimeTol_s) break;
+    s.dtheta_b_rad = R_b_imu * s.dtheta_b_rad;
+    s.dv_b_mps = R_b_imu * s.dv_b_mps;
+    out.push_back(s);
+  }
+  if (out.size() < 2) {
+    throw InputError(path, 0, "time",
+                     "fewer than 2 IMU samples inside the configured span [" +
+                         Num(config.start_time_s) + ", " + Num(config.end_time_s) + "] s");
+  }
+  return out;
+}
+
+/// Bridges gaps (an interval > 1.5 nominal and <= max_gap_s) by spreading the increments
+/// of the sample after the gap evenly over round(dt / nominal) intervals: the time tags say
+/// the increments cover the whole gap (an IMU that accumulates while its output is dropped);
+/// for an IMU that lost the samples instead, the lost increments are an error that short
+/// gaps keep small. Longer gaps: InputError naming the file and the time.
+std::vector<ImuSample> BridgeGaps(const std::vector<ImuSample>& imu, const std::string& path,
+                                  double time_offset_s, double max_gap_s, std::size_t* bridged) {
+  const double nominal = MedianInterval(imu);
+  std::vector<ImuSample> out;
+  out.reserve(imu.size());
+  for (const ImuSample& s : imu) {
+    if (s.dt_s <= kGapFactor * nominal) {
+      out.push_back(s);
+      continue;
+    }
+    const double t0 = s.t_s - s.dt_s;
+    if (s.dt_s > max_gap_s) {
+      throw InputError(path, 0, "time",
+                       "IMU gap of " + Num(s.dt_s) + " s between t = " + Num(t0 - time_offset_s) +
+                           " s and t = " + Num(s.t_s - time_offset_s) +
+                           " s (file time), longer than filter.max_bridge_gap_s = " +
+                           Num(max_gap_s) + " s (nominal interval " + Num(nominal) + " s)");
+    }
+    const int n = std::max(2, static_cast<int>(std::lround(s.dt_s / nominal)));
+    for (int k = 1; k <= n; ++k) {
+      ImuSample piece = s;
+      piece.t_s = k == n ? s.t_s : t0 + s.dt_s * k / n;
+      piece.dt_s = piece.t_s - (t0 + s.dt_s * (k - 1) / n);
+      piece.dtheta_b_rad = s.dtheta_b_rad / n;
+      piece.dv_b_mps = s.dv_b_mps / n;
+      out.push_back(piece);
+    }
+    ++*bridged;
+  }
+  return out;
+}
+
+std::vector<GnssSample> ReadGnss(const std::string& path, double t_begin, double t_end) {
+  auto reader = OpenGnss(path);
+  std::vector<GnssSample> out;
+  GnssSample g;
+  double previous_t = -std::numeric_limits<double>::infinity();
+  while (reader->Next(&g)) {
+    // The readers check these already (and name the line); kept as a safety net for
+    // every format.
+    RequireFinite(std::isfinite(g.t_s), path, "time", g.t_s);
+    RequireFinite(std::isfinite(g.lat_rad) && std::isfinite(g.lon_rad) && std::isfinite(g.h_m), path,
+                  "position", g.t_s);
+    if (!(g.t_s > previous_t)) {
+      throw InputError(path, 0, "time",
+                       "GNSS epoch t = " + Num(g.t_s) + " s is not after the previous one (" +
+                           Num(previous_t) + " s): epochs out of order or duplicated");
+    }
+    previous_t = g.t_s;
+    for (int i = 0; i < 3; ++i) {
+      const double ps = g.pos_std_ned_m[i];
+      if (!std::isnan(ps) && !(ps > 0.0 && std::isfinite(ps))) {
+        throw InputError(path, 0, "position sigma",
+                         "must be > 0 and finite (epoch t = " + Num(g.t_s) + " s)");
+      }
+      const double vs = g.vel_std_ned_mps[i];
+      if (g.has_velocity && !std::isnan(vs) && !(vs > 0.0 && std::isfinite(vs))) {
+        throw InputError(path, 0, "velocity sigma",
+                         "must be > 0 and finite (epoch t = " + Num(g.t_s) + " s)");
+      }
+    }
+    if (g.has_velocity) RequireFinite(g.v_n_mps.allFinite(), path, "velocity", g.t_s);
+    if (g.t_s < t_begin - kTimeTol_s) continue;
+    if (g.t_s > t_end + kTimeTol_s) continue;  // keep reading: later lines are still checked
+    out.push_back(g);
+  }
+  return out;
+}
+
+std::vector<MagSample> ReadMag(const std::string& path, double t_begin, double t_end) {
+  auto reader = OpenMag(path);
+  std::vector<MagSample> out;
+  MagSample m;
+  while (reader->Next(&m)) {
+    RequireFinite(std::isfinite(m.t_s), path, "time", m.t_s);
+    RequireFinite(m.m_b_uT.allFinite(), path, "field", m.t_s);
+    if (m.t_s < t_begin - kTimeTol_s) continue;
+    if (m.t_s > t_end + kTimeTol_s) break;
+    out.push_back(m);
+  }
+  return out;
+}
+
+std::vector<BaroSample> ReadBaro(const std::string& path, double t_begin, double t_end) {
+  auto reader = OpenBaro(path);
+  std::vector<BaroSample> out;
+  BaroSample b;
+  while (reader->Next(&b)) {
+    RequireFinite(std::isfinite(b.t_s), path, "time", b.t_s);
+    if (!std::isfinite(b.altitude_m)) {
+      if (!(std::isfinite(b.pressure_pa) && b.pressure_pa > 0.0)) {
+        throw InputError(path, 0, "altitude_m",
+                         "neither an altitude nor a positive pressure (sample at t = " + Num(b.t_s) +
+                             " s)");
+      }
+      b.altitude_m = IsaAltitude_m(b.pressure_pa);
+    }
+    if (b.t_s < t_begin - kTimeTol_s) continue;
+    if (b.t_s > t_end + kTimeTol_s) break;
+    out.push_back(b);
+  }
+  return out;
+}
+
+}  // namespace
+
+Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
+  if (paths.imu.empty()) throw InputError("(no file)", 0, "imu", "no IMU file given");
+  if (paths.gnss.empty()) throw InputError("(no file)", 0, "gnss", "no GNSS file given");
+  Inputs in;
+  in.paths = paths;
+  in.imu = BridgeGaps(ReadImu(paths.imu, config), paths.imu, config.installation.imu_time_offset_s,
+                      config.filter.max_bridge_gap_s, &in.bridged_imu_gaps);
+  const double t_begin = in.imu.front().t_s - in.imu.front().dt_s;
+  const double t_end = in.imu.back().t_s;
+
+  in.gnss = ReadGnss(paths.gnss, t_begin, t_end);
+  if (in.gnss.empty()) {
+    throw InputError(paths.gnss, 0, "time",
+                     "no GNSS epoch inside the IMU span [" + Num(t_begin) + ", " + Num(t_end) +
+                         "] s (check the time scales: GPS seconds of week vs. relative time, "
+                         "installation.imu_time_offset_s)");
+  }
+
+  // Injected outages: [t_begin + start + k period, ... + len), k = 0, 1, ... .
+  const OutageConfig& o = config.outages;
+  if (!std::isnan(o.start_s)) {
+    if (!(o.len_s > 0.0) || o.start_s < 0.0 || o.period_s < 0.0 ||
+        (o.period_s > 0.0 && o.period_s <= o.len_s)) {
+      throw std::invalid_argument("outages: need start_s >= 0, len_s > 0 and period_s 0 or > len_s");
+    }
+    for (double a = t_begin + o.start_s; a < t_end; a += o.period_s) {
+      in.outages.emplace_back(a, a + o.len_s);
+      if (o.period_s <= 0.0) break;
+    }
+    std::vector<GnssSample> kept;
+    kept.reserve(in.gnss.size());
+    std::size_t k = 0;
+    for (const GnssSample& g : in.gnss) {
+      while (k < in.outages.size() && g.t_s >= in.outages[k].second) ++k;
+      if (k < in.outages.size() && g.t_s >= in.outages[k].first) {
+        ++in.gnss_removed_by_outages;
+      } else {
+        kept.push_back(g);
+      }
+    }
+    in.gnss = std::move(kept);
+    if (in.gnss.empty()) {
+      throw InputError(paths.gnss, 0, "time", "the injected outages remove every GNSS epoch");
+    }
+  }
+
+  if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, t_begin, t_end);
+  if (!paths.baro.empty()) in.baro = ReadBaro(paths.baro, t_begin, t_end);
+  return in;
+}
+
+}  // namespace navtwin::gnss_ins

@@ -1,0 +1,98 @@
+#include "problems/gnss_ins/output.h"
+
+#include <cmath>
+#include <limits>
+
+#include "core/io/text_line.h"
+#include "core/rotation.h"
+
+namespace navtwin::gnss_ins {
+namespace {
+
+constexpr double kRadpsToDegH = kRadToDeg * 3600.0;
+/// m/s^2 -> mg (1 mg = 1e-3 standard gravity, 9.80665 m/s^2).
+constexpr double kMps2ToMg = 1.0 / (1e-3 * 9.80665);
+constexpr double kToPpm = 1e6;
+
+/// One CSV row, numbers in the shortest form that reads back exactly (TextLine: the
+/// files have a row per IMU epoch, so stream formatting would dominate the run).
+void Row(std::ostream& out, double t_s, const double* values, int n) {
+  TextLine line;
+  line.Number(t_s);
+  for (int i = 0; i < n; ++i) line.Char(',').Number(values[i]);
+  line.Char('\n').WriteTo(out);
+}
+
+}  // namespace
+
+const char* const NavOutputWriter::kFiles[4] = {"nav.nav", "nav.csv", "std.csv", "imu_errors.csv"};
+
+NavOutputWriter::NavOutputWriter(const std::string& dir, bool scale_factors)
+    : scale_factors_(scale_factors),
+      nav_(dir + "/" + kFiles[0]),
+      csv_(dir + "/" + kFiles[1]),
+      std_(dir + "/" + kFiles[2]),
+      errors_(dir + "/" + kFiles[3]) {
+  csv_.stream() << "t_s,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg\n";
+  std_.stream() << "t_s,pos_n_std_m,pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,"
+                   "vel_d_std_mps,att_n_std_deg,att_e_std_deg,att_d_std_deg,bg_x_std_deg_h,"
+                   "bg_y_std_deg_h,bg_z_std_deg_h,ba_x_std_mg,ba_y_std_mg,ba_z_std_mg";
+  if (scale_factors_) {
+    std_.stream() << ",sg_x_std_ppm,sg_y_std_ppm,sg_z_std_ppm,sa_x_std_ppm,sa_y_std_ppm,sa_z_std_ppm";
+  }
+  std_.stream() << '\n';
+  errors_.stream() << "t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg";
+  if (scale_factors_) errors_.stream() << ",sg_x_ppm,sg_y_ppm,sg_z_ppm,sa_x_ppm,sa_y_ppm,sa_z_ppm";
+  errors_.stream() << '\n';
+}
+
+void NavOutputWriter::Write(const NavEpoch& epoch) {
+  const NavState& s = epoch.state.nav;
+  nav_.Write(s);  // checks the state is finite (std::invalid_argument otherwise)
+  const Eigen::Vector3d rpy_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
+  const double nav[9] = {s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m,
+                         s.v_n_mps.x(),         s.v_n_mps.y(),         s.v_n_mps.z(),
+                         rpy_deg.x(),           rpy_deg.y(),           rpy_deg.z()};
+  Row(csv_.stream(), s.t_s, nav, 9);
+
+  // Standard deviations in the units of the header; NaN where not computed.
+  const int n = scale_factors_ ? err::kSize21 : err::kSize15;
+  double sd[err::kSize21];
+  for (int i = 0; i < n; ++i) {
+    double scale = 1.0;
+    if (i >= err::kAtt && i < err::kBg) scale = kRadToDeg;
+    if (i >= err::kBg && i < err::kBa) scale = kRadpsToDegH;
+    if (i >= err::kBa && i < err::kSg) scale = kMps2ToMg;
+    if (i >= err::kSg) scale = kToPpm;
+    sd[i] = i < epoch.std.size() ? epoch.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
+  }
+  Row(std_.stream(), s.t_s, sd, n);
+
+  const ImuErrors& e = epoch.state.imu;
+  double imu[12];
+  for (int i = 0; i < 3; ++i) {
+    imu[i] = e.bg_radps[i] * kRadpsToDegH;
+    imu[3 + i] = e.ba_mps2[i] * kMps2ToMg;
+    imu[6 + i] = e.sg[i] * kToPpm;
+    imu[9 + i] = e.sa[i] * kToPpm;
+  }
+  Row(errors_.stream(), s.t_s, imu, scale_factors_ ? 12 : 6);
+  ++count_;
+}
+
+void NavOutputWriter::Commit() {
+  nav_.Commit();
+  csv_.Commit();
+  std_.Commit();
+  errors_.Commit();
+}
+
+void WriteJsonFile(const std::string& path, const std::function<void(JsonWriter&)>& body) {
+  AtomicFile file(path);
+  JsonWriter w(file.stream());
+  body(w);
+  file.stream() << '\n';
+  file.Commit();
+}
+
+}  // namespace navtwin::gnss_ins

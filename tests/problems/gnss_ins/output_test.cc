@@ -1,0 +1,172 @@
+// NavOutputWriter: the four files, their columns and units, and atomicity.
+#include "problems/gnss_ins/output.h"
+
+#include <sys/stat.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/io/kfgins.h"
+#include "core/rotation.h"
+#include "tests/core/io/io_test_util.h"
+
+namespace navtwin::gnss_ins {
+namespace {
+
+using navtwin::testing::MakeTempDir;
+using navtwin::testing::ReadAllSamples;
+
+bool Exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::vector<double> Numbers(const std::string& csv_line) {
+  std::vector<double> v;
+  std::stringstream ss(csv_line);
+  for (std::string f; std::getline(ss, f, ',');) v.push_back(std::stod(f));
+  return v;
+}
+
+NavEpoch Epoch(double t, int n_std) {
+  NavEpoch e;
+  e.state.nav.t_s = t;
+  e.state.nav.gps_week = 2200;
+  e.state.nav.lat_rad = 30.0 * kDegToRad;
+  e.state.nav.lon_rad = 114.0 * kDegToRad;
+  e.state.nav.h_m = 20.0;
+  e.state.nav.v_n_mps = Eigen::Vector3d(1.0, 2.0, -0.5);
+  e.state.nav.q_n_b = QuatFromEuler(1.0 * kDegToRad, -2.0 * kDegToRad, 100.0 * kDegToRad);
+  e.state.imu.bg_radps = Eigen::Vector3d(10.0, 0, 0) * kDegToRad / 3600.0;  // 10 deg/h
+  e.state.imu.ba_mps2 = Eigen::Vector3d(0, 2e-3 * 9.80665, 0);            // 2 mg
+  e.state.imu.sg = Eigen::Vector3d(0, 0, 300e-6);                          // 300 ppm
+  e.state.imu.sa = Eigen::Vector3d(100e-6, 0, 0);
+  e.std = Eigen::VectorXd::Constant(n_std, 0.0);
+  if (n_std > 0) {
+    e.std.segment<3>(0).setConstant(0.5);                              // m
+    e.std.segment<3>(3).setConstant(0.05);                             // m/s
+    e.std.segment<3>(6).setConstant(0.2 * kDegToRad);                  // 0.2 deg
+    e.std.segment<3>(9).setConstant(5.0 * kDegToRad / 3600.0);         // 5 deg/h
+    e.std.segment<3>(12).setConstant(0.5e-3 * 9.80665);                // 0.5 mg
+  }
+  if (n_std == 21) e.std.segment<6>(15).setConstant(200e-6);           // 200 ppm
+  return e;
+}
+
+// Unit conversions multiply by exact constants: 1e-9 relative covers the shortest-form
+// printing and the conversions' rounding.
+constexpr double kTol = 1e-9;
+
+TEST(NavOutputWriter, WritesFourFilesInTheirUnits) {
+  const std::string dir = MakeTempDir();
+  {
+    NavOutputWriter w(dir, /*scale_factors=*/false);
+    w.Write(Epoch(100.0, 15));
+    w.Write(Epoch(100.005, 15));
+    EXPECT_EQ(w.count(), 2u);
+    for (const char* f : NavOutputWriter::kFiles) EXPECT_FALSE(Exists(dir + "/" + f)) << f;
+    w.Commit();
+  }
+  // nav.nav reads back with the KF-GINS reader.
+  auto reader = OpenKfginsNav(dir + "/nav.nav");
+  const std::vector<NavState> nav = ReadAllSamples(*reader);
+  ASSERT_EQ(nav.size(), 2u);
+  EXPECT_EQ(nav[1].t_s, 100.005);
+  EXPECT_EQ(nav[1].gps_week, 2200);
+  EXPECT_NEAR(nav[1].lat_rad, 30.0 * kDegToRad, 1e-15);
+
+  const auto csv = Lines(dir + "/nav.csv");
+  ASSERT_EQ(csv.size(), 3u);
+  EXPECT_EQ(csv[0], "t_s,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg");
+  const std::vector<double> row = Numbers(csv[1]);
+  ASSERT_EQ(row.size(), 10u);
+  EXPECT_NEAR(row[1], 30.0, kTol);
+  EXPECT_NEAR(row[2], 114.0, kTol);
+  EXPECT_EQ(row[6], -0.5);
+  EXPECT_NEAR(row[7], 1.0, kTol);
+  EXPECT_NEAR(row[8], -2.0, kTol);
+  EXPECT_NEAR(row[9], 100.0, kTol);
+
+  const auto sd = Lines(dir + "/std.csv");
+  ASSERT_EQ(sd.size(), 3u);
+  EXPECT_EQ(Numbers(sd[1]).size(), 16u);
+  EXPECT_NE(sd[0].find("att_n_std_deg"), std::string::npos);
+  EXPECT_EQ(sd[0].find("sg_x_std_ppm"), std::string::npos);
+  const std::vector<double> s = Numbers(sd[1]);
+  EXPECT_NEAR(s[1], 0.5, kTol);
+  EXPECT_NEAR(s[4], 0.05, kTol);
+  EXPECT_NEAR(s[7], 0.2, kTol);
+  EXPECT_NEAR(s[10], 5.0, kTol);
+  EXPECT_NEAR(s[13], 0.5, kTol);
+
+  const auto err = Lines(dir + "/imu_errors.csv");
+  ASSERT_EQ(err.size(), 3u);
+  EXPECT_EQ(err[0], "t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg");
+  const std::vector<double> e = Numbers(err[1]);
+  ASSERT_EQ(e.size(), 7u);
+  EXPECT_NEAR(e[1], 10.0, kTol);
+  EXPECT_NEAR(e[5], 2.0, kTol);
+}
+
+TEST(NavOutputWriter, ScaleFactorColumnsAndMissingStd) {
+  const std::string dir = MakeTempDir();
+  NavOutputWriter w(dir, /*scale_factors=*/true);
+  w.Write(Epoch(1.0, 21));
+  w.Write(Epoch(2.0, 0));  // no standard deviations computed: nan
+  w.Commit();
+  const auto sd = Lines(dir + "/std.csv");
+  ASSERT_EQ(sd.size(), 3u);
+  const std::vector<double> s = Numbers(sd[1]);
+  ASSERT_EQ(s.size(), 22u);
+  EXPECT_NEAR(s[16], 200.0, kTol);
+  EXPECT_NE(sd[0].find("sa_z_std_ppm"), std::string::npos);
+  const std::vector<double> missing = Numbers(sd[2]);
+  ASSERT_EQ(missing.size(), 22u);
+  EXPECT_TRUE(std::isnan(missing[1]));
+  const std::vector<double> e = Numbers(Lines(dir + "/imu_errors.csv")[1]);
+  ASSERT_EQ(e.size(), 13u);
+  EXPECT_NEAR(e[9], 300.0, kTol);   // sg_z
+  EXPECT_NEAR(e[10], 100.0, kTol);  // sa_x
+}
+
+// A run that fails (the writer destroyed before Commit) leaves no file behind.
+TEST(NavOutputWriter, NothingAppearsWithoutCommit) {
+  const std::string dir = MakeTempDir();
+  {
+    NavOutputWriter w(dir, false);
+    w.Write(Epoch(1.0, 15));
+  }
+  EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
+}
+
+TEST(NavOutputWriter, RejectsNonFiniteStates) {
+  const std::string dir = MakeTempDir();
+  NavOutputWriter w(dir, false);
+  NavEpoch e = Epoch(1.0, 15);
+  e.state.nav.h_m = std::nan("");
+  EXPECT_THROW(w.Write(e), std::invalid_argument);
+}
+
+TEST(WriteJsonFile, WritesAtomically) {
+  const std::string dir = MakeTempDir();
+  WriteJsonFile(dir + "/s.json", [](JsonWriter& w) { w.BeginObject().Field("a", 1.5).EndObject(); });
+  EXPECT_EQ(Lines(dir + "/s.json").at(0), "{\"a\":1.5}");
+  EXPECT_THROW(WriteJsonFile(dir + "/t.json", [](JsonWriter&) { throw std::runtime_error("x"); }),
+               std::runtime_error);
+  EXPECT_FALSE(Exists(dir + "/t.json"));
+}
+
+}  // namespace
+}  // namespace navtwin::gnss_ins
