@@ -21,7 +21,6 @@
 #include <optional>
 #include <sstream>
 
-#include <yaml-cpp/yaml.h>
 
 #include "apps/navtwin/command.h"
 #include "core/io/atomic_file.h"
@@ -40,6 +39,7 @@
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/output.h"
 #include "problems/gnss_ins/scoring.h"
+#include "problems/gnss_ins/sim_config.h"
 
 DECLARE_string(format);
 DECLARE_string(imu);
@@ -59,6 +59,8 @@ DEFINE_string(smoother, "", "navigate: rts = write the RTS-smoothed solution ins
 DEFINE_double(outage_start_s, NAN, "Injected GNSS outages for scoring: first outage start, s after the first IMU epoch");
 DEFINE_double(outage_len_s, 0.0, "Injected GNSS outages: length of each, s");
 DEFINE_double(outage_period_s, 0.0, "Injected GNSS outages: period, s (0: a single outage)");
+DEFINE_string(demo_scenario, "mems-gps-mag-maneuver", "smooth --demo: the simulated scenario (a preset name or a scenario YAML)");
+DEFINE_string(demo_mag, "vector", "smooth --demo: magnetometer use, off|vector|heading|heading_2axis");
 
 namespace navtwin::app {
 namespace {
@@ -68,8 +70,6 @@ using gnss_ins::Inputs;
 using gnss_ins::NavEpoch;
 using gnss_ins::ScoreReport;
 using gnss_ins::Solution;
-
-constexpr const char* kDemoScenario = "mems-gps-mag-maneuver";
 
 int Usage(const std::string& command, const std::string& why, const std::string& usage) {
   std::cerr << "navtwin " << command << ": " << why << "\nusage: " << usage << "\n";
@@ -117,13 +117,6 @@ struct RunFiles {
   std::string imu, gnss, mag, baro, config, kfgins_config, truth, out;
 };
 
-std::string Vec(const Eigen::Vector3d& v, double per_unit = 1.0) {
-  std::ostringstream s;
-  s.precision(10);
-  s << "[" << v.x() / per_unit << ", " << v.y() / per_unit << ", " << v.z() / per_unit << "]";
-  return s.str();
-}
-
 std::string Num(double x) {
   std::ostringstream s;
   s.precision(10);
@@ -131,73 +124,34 @@ std::string Num(double x) {
   return s.str();
 }
 
-/// Simulates the demo scenario into DIR/sim and writes DIR/sim/navtwin.yaml.
+/// Simulates the demo scenario (--demo_scenario) into DIR/sim and writes the configuration
+/// a user of it would write (gnss_ins::ConfigYamlForSimulation) to DIR/sim/navtwin.yaml.
 RunFiles MakeDemo(const std::string& out) {
   const std::string sim_dir = out + "/sim";
   if (!IsDir(sim_dir) && ::mkdir(sim_dir.c_str(), 0755) != 0) {
     throw std::runtime_error("cannot create " + sim_dir);
   }
-  const sim::Scenario scenario = sim::LoadScenario(kDemoScenario);
+  const std::string name = FLAGS_demo_scenario;
+  const sim::Scenario scenario = sim::LoadScenario(name);
+  if (!scenario.gnss) throw std::runtime_error("--demo_scenario " + name + " has no GNSS");
   sim::SimulationOptions options;
   options.seed = FLAGS_seed;
-  options.progress = [](double fraction) {
-    std::fprintf(stderr, "\rsmooth --demo: simulating %s %3.0f %%", kDemoScenario, 100.0 * fraction);
+  options.progress = [&name](double fraction) {
+    std::fprintf(stderr, "\rsmooth --demo: simulating %s %3.0f %%", name.c_str(), 100.0 * fraction);
     if (fraction >= 1.0) std::fprintf(stderr, "\n");
   };
   sim::Simulate(scenario, options, sim_dir);
-
-  // The magnetometer's calibration and the Earth field as drawn by the simulation
-  // (errors.yaml): what a user gets from a calibration (e.g. a figure-eight swing) and a
-  // field model.
-  const YAML::Node errors = YAML::LoadFile(sim_dir + "/errors.yaml");
-  const YAML::Node mag = errors["mag"];
-  auto vec = [](const YAML::Node& n) {
-    return Eigen::Vector3d(n[0].as<double>(), n[1].as<double>(), n[2].as<double>());
-  };
-  const sim::TriadErrorConfig& gyro = scenario.imu.errors.gyro;
-  const sim::TriadErrorConfig& accel = scenario.imu.errors.accel;
-  constexpr double kG0 = 9.80665;
-  std::ostringstream y;
-  y << "# navtwin configuration written by `navtwin smooth --demo` for the simulated\n"
-       "# " << kDemoScenario << " flight (seed " << FLAGS_seed << "): the scenario's IMU noise,\n"
-       "# GNSS lever arm and initial state (init.nav), and the magnetometer calibration and\n"
-       "# field from errors.yaml, as a user with a calibrated magnetometer would have them.\n"
-       "imu_noise:\n"
-       "  gyro_arw_deg_sqrt_h: " << Num(gyro.white_noise * kRadToDeg * 60.0) << "\n"
-       "  accel_vrw_m_s_sqrt_h: " << Num(accel.white_noise * 60.0) << "\n"
-       "  gyro_bias_std_deg_h: " << Num(gyro.bias.sigma * kRadToDeg * 3600.0) << "\n"
-       "  accel_bias_std_ug: " << Num(accel.bias.sigma / (1e-6 * kG0)) << "\n"
-       "  gyro_scale_std_ppm: " << Num(gyro.scale_factor.sigma * 1e6) << "\n"
-       "  accel_scale_std_ppm: " << Num(accel.scale_factor.sigma * 1e6) << "\n"
-       "  correlation_time_s: inf   # constant turn-on biases and scale factors\n"
-       "installation:\n"
-       "  imu_mounting_deg: " << Vec(scenario.imu.mounting_rpy_rad, kDegToRad) << "\n"
-       "  antenna_lever_arm_b_m: " << Vec(scenario.gnss->lever_arm_b_m) << "\n"
-       "init:\n"
-       "  source: given\n"
-       "  nav_file: init.nav\n"
-       "  position_std_m: [5, 5, 8]\n"
-       "  velocity_std_mps: 0.5\n"
-       "  attitude_std_deg: [2, 2, 5]\n"
-       "mag:\n"
-       "  mode: vector\n"
-       "  field: {field_ned_uT: " << Vec(vec(mag["field_ned_uT"])) << "}\n"
-       "  hard_iron_uT: " << Vec(vec(mag["hard_iron_uT"])) << "\n"
-       "  soft_iron: [" << Vec(vec(mag["soft_iron"][0])) << ", " << Vec(vec(mag["soft_iron"][1]))
-    << ", " << Vec(vec(mag["soft_iron"][2])) << "]\n"
-       "  noise_uT: " << Num(std::max(0.3, 3.0 * mag["noise_uT"].as<double>())) << "\n"
-       "filter:\n"
-       "  scale_factors: true\n";
+  const std::string yaml = gnss_ins::ConfigYamlForSimulation(scenario, sim_dir, FLAGS_seed, FLAGS_demo_mag);
   RunFiles f;
   f.config = sim_dir + "/navtwin.yaml";
   {
     AtomicFile file(f.config);
-    file.stream() << y.str();
+    file.stream() << yaml;
     file.Commit();
   }
   f.imu = sim_dir + "/imu.txt";
   f.gnss = sim_dir + "/gnss.txt";
-  f.mag = sim_dir + "/mag.csv";
+  if (scenario.mag && FLAGS_demo_mag != "off") f.mag = sim_dir + "/mag.csv";
   f.truth = sim_dir + "/truth.nav";
   f.out = out;
   return f;
@@ -551,7 +505,7 @@ const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--format=json]\n"
-    "       navtwin smooth --demo --out DIR [--seed N] [outage flags]";
+    "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
 
 int RunNavigate(const std::vector<std::string>& args) { return Run({"navigate", kNavigateUsage}, args); }
 int RunSmooth(const std::vector<std::string>& args) { return Run({"smooth", kSmoothUsage}, args); }
@@ -572,7 +526,8 @@ Command SmoothCommand() {
           "Filter, RTS and full-batch Ceres smoother over a record; prints the comparison table",
           kSmoothUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "truth", "output_rate_hz",
-           "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed"},
+           "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
+           "demo_scenario", "demo_mag"},
           &RunSmooth};
 }
 
