@@ -159,6 +159,8 @@ ErrorStateKalmanFilter::Update ErrorStateKalmanFilter::Correct(const Eigen::Vect
     throw std::runtime_error("ErrorStateKalmanFilter::Correct: innovation covariance not positive definite");
   }
   u.nis = y.dot(llt.solve(y));
+  // S = L L^T: log det S = 2 sum log L_ii.
+  u.log_det_s = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
   u.gate = gate_probability >= 1.0 ? std::numeric_limits<double>::infinity()
                                    : ChiSquareQuantile(gate_probability, m);
   if (!(u.nis <= u.gate)) {

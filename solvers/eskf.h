@@ -34,6 +34,7 @@ class ErrorStateKalmanFilter {
   struct Update {
     bool accepted = false;
     double nis = 0.0;   ///< normalised innovation squared y^T S^-1 y, S = H P H^T + I
+    double log_det_s = 0.0;  ///< log det S (with nis: -2 log N(y; 0, S) = nis + log det S + m log 2 pi)
     double gate = 0.0;  ///< the chi-square threshold used (inf when not gating)
     Eigen::VectorXd dx; ///< the error-state estimate K y (zero when rejected)
   };

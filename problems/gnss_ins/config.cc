@@ -158,7 +158,8 @@ InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double
                  "position_std_m", "velocity_std_mps", "attitude_std_deg", "gyro_bias_deg_h",
                  "accel_bias_ug", "gyro_scale_ppm", "accel_scale_ppm", "gyro_bias_std_deg_h",
                  "accel_bias_std_ug", "gyro_scale_std_ppm", "accel_scale_std_ppm",
-                 "static_duration_s", "min_speed_mps"});
+                 "static_duration_s", "min_speed_mps", "heading", "heading_hypotheses",
+                 "heading_search_s"});
   InitConfig x;
   const std::string source = n.String("source", "given");
   if (source == "given") {
@@ -222,6 +223,30 @@ InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double
   x.std.sa = SigmaVector(n, "accel_scale_std_ppm", Eigen::Vector3d::Zero()) * kPpm;
   x.static_duration_s = Sigma(n, "static_duration_s", x.static_duration_s);
   x.min_speed_mps = Sigma(n, "min_speed_mps", x.min_speed_mps);
+  // The alignment's heading (source: static only); its magnetometer needs mag.mode, which
+  // LoadGnssInsConfig checks once the mag section is read.
+  const std::string heading = n.String("heading", "auto");
+  if (heading == "auto") {
+    x.heading = InitConfig::Heading::kAuto;
+  } else if (heading == "gyrocompass") {
+    x.heading = InitConfig::Heading::kGyrocompass;
+  } else if (heading == "magnetometer") {
+    x.heading = InitConfig::Heading::kMagnetometer;
+  } else if (heading == "search") {
+    x.heading = InitConfig::Heading::kSearch;
+  } else {
+    n.Fail("heading", "expected auto, gyrocompass, magnetometer or search, got '" + heading + "'");
+  }
+  for (const char* key : {"heading", "heading_hypotheses", "heading_search_s"}) {
+    if (n.Has(key) && x.source != InitConfig::Source::kStaticAlignment) {
+      n.Fail(key, "only with source: static (the heading of the static alignment)");
+    }
+  }
+  for (const char* key : {"heading_hypotheses", "heading_search_s"}) {
+    if (n.Has(key) && x.heading != InitConfig::Heading::kSearch) n.Fail(key, "only with heading: search");
+  }
+  x.heading_hypotheses = n.Int("heading_hypotheses", x.heading_hypotheses, 2, 360);
+  x.heading_search_s = Sigma(n, "heading_search_s", x.heading_search_s);
   return x;
 }
 
@@ -455,6 +480,9 @@ GnssInsConfig LoadGnssInsConfig(const std::string& path) {
   c.installation = ParseInstallation(root.Child("installation"));
   c.init = ParseInit(root.Child("init"), path, c.start_time_s);
   c.mag = ParseMag(root.Child("mag"));
+  if (c.init.heading == InitConfig::Heading::kMagnetometer && c.mag.mode == MagConfig::Mode::kOff) {
+    root.Child("init").Fail("heading", "magnetometer needs a magnetometer (mag.mode other than off)");
+  }
   c.baro = ParseBaro(root.Child("baro"));
   c.zupt = ParseZupt(root.Child("zupt"));
   c.gnss = ParseGnss(root.Child("gnss"));

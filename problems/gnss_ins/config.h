@@ -59,9 +59,20 @@ struct InitConfig {
     kGnssVelocity,     ///< level attitude, heading from the GNSS velocity once the speed
                        ///< exceeds min_speed_mps; position and velocity from GNSS
   };
+  /// Heading of the static alignment (kStaticAlignment only).
+  enum class Heading {
+    kAuto,          ///< the magnetometer when mag.mode is not off, else gyrocompassing
+    kGyrocompass,   ///< from the mean angular rate (the Earth rate: navigation-grade gyros only)
+    kMagnetometer,  ///< from the mean magnetometer sample (needs mag.mode not off)
+    kSearch,        ///< one filter per heading hypothesis over the first GNSS data, the most
+                    ///< likely one wins (problems/gnss_ins/heading_search.h)
+  };
   Source source = Source::kGiven;
   std::optional<InsState> state;  ///< required for kGiven (time = start)
   double static_duration_s = 60.0;
+  Heading heading = Heading::kAuto;
+  int heading_hypotheses = 8;      ///< kSearch: headings k 360 deg / heading_hypotheses
+  double heading_search_s = 30.0;  ///< kSearch: GNSS data (s of epochs) after the alignment
   double min_speed_mps = 5.0;
   ImuErrors imu_errors;           ///< initial IMU error estimates (KF-GINS initgyrbias, ...)
   InitialStd std;

@@ -58,7 +58,7 @@ class NavigationFilter {
         keep_covariances_(keep_covariances),
         output_(output),
         progress_(progress),
-        start_(InitialFilterState(inputs, config)),
+        start_(InitialFilterState(inputs, config, progress)),
         strapdown_(start_.state.nav),
         imu_(start_.state.imu),
         kf_(InitialCovariance(config, n_)),
@@ -192,11 +192,18 @@ class NavigationFilter {
     kf_.SetP(P_);
     const ErrorStateKalmanFilter::Update u = kf_.Correct(y_, H_, cfg_.filter.gate_probability);
     MeasurementCount& count = counts_[key];
+    InnovationStats& stats = innovations_[key];
+    ++stats.updates;
+    stats.nis_capped += std::min(u.nis, u.gate);
+    stats.log_det_s += u.log_det_s;
     if (!u.accepted) {
       ++count.rejected;
+      ++stats.rejected;
       return false;
     }
     ++count.used;
+    stats.nis += u.nis;
+    stats.dof += m;
     P_ = kf_.P();
     const InsState corrected = ApplyCorrection(Nominal(), u.dx);
     strapdown_.SetState(corrected.nav);
@@ -332,6 +339,7 @@ class NavigationFilter {
   std::vector<Eigen::MatrixXd> filter_covariances_;
   std::vector<RtsKnot> knots_;
   std::map<std::string, MeasurementCount> counts_;
+  std::map<std::string, InnovationStats> innovations_;
 
   // Measurement models' scratch.
   PositionManifold position_manifold_;
@@ -445,6 +453,7 @@ FilterResult NavigationFilter::Run() {
     result.rts = std::move(rts);
   }
   result.filter_covariances = std::move(filter_covariances_);
+  result.innovations = std::move(innovations_);
   return result;
 }
 

@@ -26,8 +26,10 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <ostream>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -40,6 +42,18 @@
 #include "problems/gnss_ins/solution.h"
 
 namespace navtwin::gnss_ins {
+
+/// Innovations of one measurement kind over a run, updates rejected by the gate included:
+/// the terms of their Gaussian log-likelihood, -2 log L = sum (NIS + log det S + m log 2 pi),
+/// S = H P H^T + I (whitened). The heading search (heading_search.h) scores with it.
+struct InnovationStats {
+  std::size_t updates = 0;   ///< accepted and rejected
+  std::size_t rejected = 0;  ///< by the chi-square gate
+  double nis = 0.0;          ///< sum of NIS over the accepted updates
+  int dof = 0;               ///< sum of their dimensions m (a consistent filter: E[nis] = dof)
+  double nis_capped = 0.0;   ///< sum of min(NIS, gate) over every update (a rejected one costs the gate)
+  double log_det_s = 0.0;    ///< sum of log det S over every update
+};
 
 struct FilterResult {
   /// Method "filter": the knots (post-update states after every update epoch and at least
@@ -57,6 +71,8 @@ struct FilterResult {
   /// to keep them (consistency checks).
   std::vector<Eigen::MatrixXd> filter_covariances;
   std::vector<Eigen::MatrixXd> rts_covariances;
+  /// Per measurement kind (the keys of Solution::counts).
+  std::map<std::string, InnovationStats> innovations;
 };
 
 /// Runs the error-state filter over the inputs (and the RTS smoother when run_rts).
@@ -68,9 +84,11 @@ struct FilterResult {
 /// Initialisation per config.init.source (kGiven: config.init.state at its time, IMU
 /// errors from config.init.imu_errors when any is non-zero, else from the state;
 /// kStaticAlignment: coarse alignment over the first static_duration_s of IMU data,
-/// position from the first GNSS fix, velocity zero; kGnssVelocity: at the first GNSS fix
-/// with velocity and horizontal speed >= min_speed_mps). Initial covariance
-/// diag(InitialStdVector(config, n))^2, n = 15, or 21 with config.filter.scale_factors.
+/// heading per config.init.heading (kSearch: SearchHeading, heading_search.h, reporting
+/// the hypotheses' scores on `progress`), position from the first GNSS fix, velocity zero;
+/// kGnssVelocity: at the first GNSS fix with velocity and horizontal speed >=
+/// min_speed_mps). Initial covariance diag(InitialStdVector(config, n))^2, n = 15, or 21
+/// with config.filter.scale_factors.
 /// Throws InputError for input the filter finds wrong (a GNSS fix farther than
 /// config.gnss.max_distance_m from the INS prediction: the GNSS file and the epoch time;
 /// no data to initialise from), std::invalid_argument for an unusable configuration
@@ -80,7 +98,9 @@ FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, bool r
                        bool keep_covariances = false);
 
 /// The initial error-state standard deviations (n = 15 or 21) from config.init.std, where
-/// a zero bias / scale-factor entry is replaced by the ImuNoise value (*_std).
+/// a zero bias / scale-factor entry is replaced by the ImuNoise value (*_std), and with a
+/// heading search (static alignment, kSearch) the heading's (phi_D) is the search's,
+/// HeadingSearchYawStd (heading_search.h).
 Eigen::VectorXd InitialStdVector(const GnssInsConfig& config, int n);
 
 /// Where the filter starts (problems/gnss_ins/filter_support.cc).
@@ -91,11 +111,15 @@ struct FilterStart {
   bool use_measurements_at_start = true;
 };
 
-/// The initial state per config.init.source (see RunFilter). Throws InputError when the
-/// inputs hold no data to initialise from (no IMU samples; no GNSS fix for the alignment's
-/// position; no fast enough GNSS velocity; IMU data not static), std::invalid_argument
-/// for kGiven without a state.
-FilterStart InitialFilterState(const Inputs& inputs, const GnssInsConfig& config);
+/// The initial state per config.init.source (see RunFilter); a heading search reports on
+/// `progress` when not null (it is deterministic: every call picks the same heading).
+/// Throws InputError when the inputs hold no data to initialise from (no IMU samples; no
+/// GNSS fix for the alignment's position; no magnetometer sample for its heading; no GNSS
+/// epoch after it for a heading search; no fast enough GNSS velocity; IMU data not
+/// static), std::invalid_argument for kGiven without a state or a magnetometer heading
+/// with mag.mode off.
+FilterStart InitialFilterState(const Inputs& inputs, const GnssInsConfig& config,
+                               std::ostream* progress = nullptr);
 
 /// Covariance propagation over one covariance group: P <- Phi P Phi^T + Qd with Phi and Qd
 /// as DiscreteErrorDynamics (error_dynamics.h) defines them, Phi = I + F dt + (F dt)^2 / 2,

@@ -1,5 +1,6 @@
 // Support of the navigation filter (problems/gnss_ins/filter.h): initial state per
-// InitConfig::Source, initial standard deviations, magnetometer calibration, measurement
+// InitConfig::Source (and the static alignment's heading, a search in heading_search.cc),
+// initial standard deviations, magnetometer calibration, measurement
 // sigmas and ZUPT stillness detection. The main loop is in filter.cc.
 #include "problems/gnss_ins/filter.h"
 
@@ -16,6 +17,7 @@
 #include "core/rotation.h"
 #include "problems/gnss_ins/alignment.h"
 #include "problems/gnss_ins/error_dynamics.h"
+#include "problems/gnss_ins/heading_search.h"
 
 namespace navtwin::gnss_ins {
 namespace {
@@ -67,7 +69,7 @@ FilterStart GivenStart(const Inputs& inputs, const GnssInsConfig& config) {
   return start;
 }
 
-FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& config) {
+FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& config, std::ostream* progress) {
   const InitConfig& init = config.init;
   const double begin_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
   const double end_s = begin_s + init.static_duration_s;
@@ -82,8 +84,15 @@ FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& conf
                      "record is empty");
   }
   const GnssSample& fix = inputs.gnss.front();
+  // The heading reference: the magnetometer (kMagnetometer, or kAuto with one), else the
+  // mean angular rate (gyrocompassing; for kSearch only roll and pitch are kept).
+  const InitConfig::Heading heading = init.heading;
+  const bool mag_on = config.mag.mode != MagConfig::Mode::kOff;
+  if (heading == InitConfig::Heading::kMagnetometer && !mag_on) {
+    throw std::invalid_argument("RunFilter: init.heading magnetometer needs mag.mode other than off");
+  }
   std::optional<Eigen::Vector3d> m_b_uT;
-  if (config.mag.mode != MagConfig::Mode::kOff) {
+  if (heading == InitConfig::Heading::kMagnetometer || (heading == InitConfig::Heading::kAuto && mag_on)) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;
     for (const MagSample& m : inputs.mag) {
@@ -93,6 +102,11 @@ FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& conf
       ++count;
     }
     if (count > 0) m_b_uT = sum / count;
+    if (count == 0 && heading == InitConfig::Heading::kMagnetometer) {
+      throw InputError(inputs.paths.mag, 0, "heading",
+                       "no magnetometer sample in the static alignment window (the first " +
+                           Seconds(init.static_duration_s) + " of IMU data)");
+    }
   }
   FilterStart start;
   start.state.imu = init.imu_errors;
@@ -109,6 +123,20 @@ FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& conf
   nav.t_s = samples.back().t_s;
   nav.gps_week = fix.gps_week;
   start.use_measurements_at_start = false;
+  if (heading == InitConfig::Heading::kSearch) {
+    // Roll and pitch from the alignment, the heading from the search; the IMU position
+    // follows the heading through the lever arm.
+    const Eigen::Vector3d rpy = EulerFromQuat<double>(nav.q_n_b);
+    const InsState levelled = start.state;
+    const auto state_for_yaw = [&](double yaw_rad) {
+      InsState s = levelled;
+      s.nav.q_n_b = QuatFromEuler<double>(rpy[0], rpy[1], yaw_rad);
+      ImuPositionFromAntenna(fix, s.nav.q_n_b, config.installation.antenna_lever_arm_b_m, &s.nav);
+      return s;
+    };
+    const HeadingSearchResult search = SearchHeading(inputs, config, state_for_yaw, progress);
+    start.state = state_for_yaw(search.hypotheses[search.best].yaw_rad);
+  }
   return start;
 }
 
@@ -231,6 +259,10 @@ Eigen::VectorXd InitialStdVector(const GnssInsConfig& config, int n) {
   std.segment<3>(err::kPos) = s.pos_ned_m;
   std.segment<3>(err::kVel) = s.vel_ned_mps;
   std.segment<3>(err::kAtt) = s.att_rad;
+  if (config.init.source == InitConfig::Source::kStaticAlignment &&
+      config.init.heading == InitConfig::Heading::kSearch) {
+    std[err::kAtt + 2] = HeadingSearchYawStd(config.init.heading_hypotheses);
+  }
   std.segment<3>(err::kBg) = OrDefault(s.bg_radps, noise.gyro_bias_std_radps);
   std.segment<3>(err::kBa) = OrDefault(s.ba_mps2, noise.accel_bias_std_mps2);
   if (n == err::kSize21) {
@@ -285,13 +317,13 @@ bool StillnessDetector::Still() const {
   return std::sqrt(var) <= config_.accel_std_threshold_mps2;
 }
 
-FilterStart InitialFilterState(const Inputs& inputs, const GnssInsConfig& config) {
+FilterStart InitialFilterState(const Inputs& inputs, const GnssInsConfig& config, std::ostream* progress) {
   if (inputs.imu.empty()) throw InputError(inputs.paths.imu, 0, "", "no IMU samples");
   switch (config.init.source) {
     case InitConfig::Source::kGiven:
       return GivenStart(inputs, config);
     case InitConfig::Source::kStaticAlignment:
-      return StaticAlignmentStart(inputs, config);
+      return StaticAlignmentStart(inputs, config, progress);
     case InitConfig::Source::kGnssVelocity:
       return GnssVelocityStart(inputs, config);
   }

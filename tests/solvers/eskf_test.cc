@@ -108,6 +108,9 @@ TEST(ErrorStateKalmanFilter, JosephUpdateEqualsTextbookUpdate) {
   EXPECT_EQ((kf.P() - kf.P().transpose()).cwiseAbs().maxCoeff(), 0.0);
   // NIS = innovation^T (H P H^T + R)^-1 innovation.
   EXPECT_NEAR(u.nis, innovation.dot((H * P * H.transpose() + R).inverse() * innovation), 1e-12);
+  // Whitened S = L^-1 (H P H^T + R) L^-T: log det S = log det(H P H^T + R) - log det R.
+  EXPECT_NEAR(u.log_det_s,
+              std::log((H * P * H.transpose() + R).determinant()) - std::log(R.determinant()), 1e-10);
   EXPECT_EQ(kf.accepted_count(), 1);
 }
 
@@ -119,6 +122,7 @@ TEST(ErrorStateKalmanFilter, GateRejectsTenSigmaOutlierAndCountsIt) {
   const auto bad = kf.Correct(y, H, 0.9999);
   EXPECT_FALSE(bad.accepted);
   EXPECT_NEAR(bad.nis, 100.0, 1e-12);
+  EXPECT_NEAR(bad.log_det_s, 3.0 * std::log(2.0), 1e-12);  // S = 2 I
   EXPECT_NEAR(bad.gate, ChiSquareQuantile(0.9999, 3), 1e-12);
   EXPECT_EQ(bad.dx.size(), 3);
   EXPECT_EQ(bad.dx.cwiseAbs().maxCoeff(), 0.0);

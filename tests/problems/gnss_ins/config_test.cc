@@ -182,6 +182,39 @@ TEST(GnssInsConfig, UnknownAndMissingKeys) {
   ExpectInputError([&] { LoadGnssInsConfig(given); }, {"init.source", "nav_file"});
 }
 
+TEST(GnssInsConfig, StaticAlignmentHeading) {
+  const std::string noise =
+      "imu_noise:\n  gyro_arw_deg_sqrt_h: 0.1\n  accel_vrw_m_s_sqrt_h: 0.1\n"
+      "  gyro_bias_std_deg_h: 1\n  accel_bias_std_ug: 100\n";
+  const InitConfig d;
+  const GnssInsConfig plain = LoadGnssInsConfig(WriteTempFile("p.yaml", noise + "init: {source: static}\n"));
+  EXPECT_EQ(plain.init.heading, InitConfig::Heading::kAuto);  // today's behaviour
+  const GnssInsConfig search = LoadGnssInsConfig(WriteTempFile(
+      "s.yaml", noise + "init: {source: static, heading: search, heading_hypotheses: 12, heading_search_s: 20}\n"));
+  EXPECT_EQ(search.init.heading, InitConfig::Heading::kSearch);
+  EXPECT_EQ(search.init.heading_hypotheses, 12);
+  EXPECT_EQ(search.init.heading_search_s, 20.0);
+  const GnssInsConfig defaults =
+      LoadGnssInsConfig(WriteTempFile("d.yaml", noise + "init: {source: static, heading: search}\n"));
+  EXPECT_EQ(defaults.init.heading_hypotheses, d.heading_hypotheses);
+  EXPECT_EQ(defaults.init.heading_search_s, d.heading_search_s);
+  EXPECT_EQ(LoadGnssInsConfig(WriteTempFile("g.yaml", noise + "init: {source: static, heading: gyrocompass}\n"))
+                .init.heading,
+            InitConfig::Heading::kGyrocompass);
+  const std::string bad = WriteTempFile("b.yaml", noise + "init: {source: static, heading: north}\n");
+  ExpectInputError([&] { LoadGnssInsConfig(bad); }, {"line 6", "init.heading", "north"});
+  const std::string mag = WriteTempFile("m.yaml", noise + "init: {source: static, heading: magnetometer}\n");
+  ExpectInputError([&] { LoadGnssInsConfig(mag); }, {"init.heading", "mag.mode"});
+  const std::string given = WriteTempFile(
+      "gv.yaml", noise + "init: {source: given, position_deg_m: [0, 0, 0], velocity_mps: [0, 0, 0], "
+                         "attitude_deg: [0, 0, 0], heading: search}\n");
+  ExpectInputError([&] { LoadGnssInsConfig(given); }, {"init.heading", "source: static"});
+  const std::string orphan = WriteTempFile("o.yaml", noise + "init: {source: static, heading_hypotheses: 4}\n");
+  ExpectInputError([&] { LoadGnssInsConfig(orphan); }, {"init.heading_hypotheses", "heading: search"});
+  const std::string one = WriteTempFile("1.yaml", noise + "init: {source: static, heading: search, heading_hypotheses: 1}\n");
+  ExpectInputError([&] { LoadGnssInsConfig(one); }, {"init.heading_hypotheses"});
+}
+
 TEST(GnssInsConfig, MagnetometerNeedsItsField) {
   const std::string head =
       "imu_noise:\n  gyro_arw_deg_sqrt_h: 0.1\n  accel_vrw_m_s_sqrt_h: 0.1\n"

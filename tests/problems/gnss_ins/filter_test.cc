@@ -633,6 +633,48 @@ TEST(GnssInsFilter, StaticAlignmentZuptAndBarometer) {
   }
 }
 
+// Heading search (heading_search.h) on the ground start without a magnetometer: roll and
+// pitch from the alignment, the heading from 8 hypotheses 45 deg apart, scored over 60 s
+// of GNSS after the 30 s alignment (30 s more at rest, then the acceleration, which makes
+// the heading observable, and half the turn).
+TEST(GnssInsFilter, StaticAlignmentHeadingSearch) {
+  const SimRecord r = SimulateRecord(ScenarioFromYaml(kGroundStartScenario), 5);
+  GnssInsConfig c;
+  c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.1 * kDegToRad / 60.0;
+  c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.05 / 60.0;
+  c.imu_noise.gyro_bias_std_radps = 5.0 * kDegPerHour;
+  c.imu_noise.accel_bias_std_mps2 = 500.0 * kMicroG;
+  c.installation.antenna_lever_arm_b_m = Eigen::Vector3d(0.5, 0.0, -0.5);
+  c.init.source = InitConfig::Source::kStaticAlignment;
+  c.init.static_duration_s = 30.0;
+  c.init.heading = InitConfig::Heading::kSearch;
+  c.init.heading_search_s = 60.0;
+  c.init.std.pos_ned_m.setConstant(2.0);
+  c.init.std.vel_ned_mps.setConstant(0.05);
+  c.init.std.att_rad = Eigen::Vector3d(0.1, 0.1, 1.0) * kDegToRad;  // yaw: the search's
+  c.zupt.enabled = true;
+  std::ostringstream log;
+  const FilterResult result = RunFilter(r.inputs, c, true, {}, &log);
+  const std::string text = log.str();
+  std::printf("%s", text.substr(0, text.find("filter:")).c_str());
+  // The true heading is 60 deg: the nearest hypothesis, 45 deg, must win.
+  const NavEpoch& first = result.filter.epochs.front();
+  EXPECT_NEAR(EulerFromQuat<double>(first.state.nav.q_n_b).z() * kRadToDeg, 45.0, 1e-9);
+  // Its yaw std is half the spacing.
+  EXPECT_NEAR(first.std[err::kAtt + 2] * kRadToDeg, 22.5, 1e-9);
+  EXPECT_NE(text.find("chosen yaw 45.0 deg"), std::string::npos);
+  // From the end of the acceleration (75 s) on, the heading is resolved as with a
+  // magnetometer: same bounds as StaticAlignmentZuptAndBarometer's.
+  const Rms f = RmsErrors(result.filter, r.truth, 45.0);
+  const Rms s = RmsErrors(*result.rts, r.truth, 45.0);
+  Print("ground start: static alignment, heading search, ZUPT, 1 m GNSS", f, s);
+  for (const Rms* e : {&f, &s}) {
+    EXPECT_LT(e->pos_m, 1.0);
+    EXPECT_LT(e->vel_mps, 0.05);
+    EXPECT_LT(std::max({e->roll_deg, e->pitch_deg, e->yaw_deg}), 0.2);
+  }
+}
+
 TEST(GnssInsFilter, HeadingFromGnssVelocity) {
   const SimRecord& r = PresetRecord("mems-gps-mag-level-flight");
   GnssInsConfig c = MemsConfig(r);
