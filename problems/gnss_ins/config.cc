@@ -372,7 +372,7 @@ OutageConfig ParseOutages(const ConfigNode& n) {
 
 FilterConfig ParseFilter(const ConfigNode& n) {
   n.RequireKeys({"scale_factors", "gate_probability", "store_interval_s", "max_bridge_gap_s",
-                 "covariance_interval_s"});
+                 "covariance_interval_s", "gnss_reset_rejections"});
   FilterConfig x;
   x.scale_factors = n.Bool("scale_factors", x.scale_factors);
   x.gate_probability = n.Double("gate_probability", x.gate_probability, 0.0, 1.0);
@@ -380,6 +380,7 @@ FilterConfig ParseFilter(const ConfigNode& n) {
   x.store_interval_s = Sigma(n, "store_interval_s", x.store_interval_s);
   x.max_bridge_gap_s = NonNegative(n, "max_bridge_gap_s", x.max_bridge_gap_s);
   x.covariance_interval_s = NonNegative(n, "covariance_interval_s", x.covariance_interval_s);
+  x.gnss_reset_rejections = n.Int("gnss_reset_rejections", x.gnss_reset_rejections, 0, 1000000);
   return x;
 }
 

@@ -136,6 +136,9 @@ struct FilterConfig {
   double gate_probability = 0.9999;    ///< chi-square gate on each innovation (1: no gating)
   double store_interval_s = 1.0;       ///< RTS knots: every update and at least this often
   double max_bridge_gap_s = 0.1;       ///< IMU gaps up to this are bridged, longer stop the run
+  /// After this many GNSS positions in a row rejected by the gate, position (and velocity)
+  /// are reset to the fix with its covariance (0: never).
+  int gnss_reset_rejections = 10;
   /// The covariance is propagated over groups of IMU samples at most this long (the
   /// nominal state at every sample); 0: at every sample.
   double covariance_interval_s = 0.02;

@@ -41,6 +41,7 @@ namespace {
 constexpr double kTimeEps_s = 1e-6;
 
 const char* const kGnssPos = "gnss_position";
+const char* const kGnssReset = "gnss_reset";
 const char* const kGnssVel = "gnss_velocity";
 const char* const kMag = "mag";
 const char* const kBaro = "baro";
@@ -70,7 +71,7 @@ class NavigationFilter {
     }
     phi_acc_ = Eigen::MatrixXd::Identity(n_, n_);
     epoch_dx_ = Eigen::VectorXd::Zero(n_);
-    for (const char* key : {kGnssPos, kGnssVel, kMag, kBaro, kZupt}) counts_[key];
+    for (const char* key : {kGnssPos, kGnssVel, kMag, kBaro, kZupt, kGnssReset}) counts_[key];
   }
 
   FilterResult Run();
@@ -216,16 +217,56 @@ class NavigationFilter {
     const Eigen::Vector3d& lever = cfg_.installation.antenna_lever_arm_b_m;
     const Eigen::Vector3d sp =
         MeasurementSigma(g.pos_std_ned_m, cfg_.gnss.pos_std_floor_m, cfg_.gnss.default_pos_std_m);
-    Update(std::unique_ptr<ceres::CostFunction>(
-               GnssPosition::Create(Eigen::Vector3d(g.lat_rad, g.lon_rad, g.h_m), lever, sp)),
-           {Block::kPosition, Block::kAttitude}, kGnssPos, &g, &sp);
-    if (cfg_.gnss.use_velocity && g.has_velocity) {
-      const Eigen::Vector3d sv =
-          MeasurementSigma(g.vel_std_ned_mps, cfg_.gnss.vel_std_floor_mps, cfg_.gnss.default_vel_std_mps);
+    const bool position_used = Update(std::unique_ptr<ceres::CostFunction>(GnssPosition::Create(
+                                          Eigen::Vector3d(g.lat_rad, g.lon_rad, g.h_m), lever, sp)),
+                                      {Block::kPosition, Block::kAttitude}, kGnssPos, &g, &sp);
+    const bool use_velocity = cfg_.gnss.use_velocity && g.has_velocity;
+    const Eigen::Vector3d sv =
+        MeasurementSigma(g.vel_std_ned_mps, cfg_.gnss.vel_std_floor_mps, cfg_.gnss.default_vel_std_mps);
+    if (use_velocity) {
       Update(std::unique_ptr<ceres::CostFunction>(GnssVelocity::Create(g.v_n_mps, lever, omega_ib_b_, sv)),
              {Block::kVelocity, Block::kAttitude}, kGnssVel);
     }
     gnss_seen_ = true;
+    gnss_rejected_in_row_ = position_used ? 0 : gnss_rejected_in_row_ + 1;
+    const int reset_after = cfg_.filter.gnss_reset_rejections;
+    if (reset_after > 0 && gnss_rejected_in_row_ >= reset_after) {
+      ResetToGnss(g, sp, use_velocity ? &sv : nullptr);
+      gnss_rejected_in_row_ = 0;
+    }
+  }
+
+  /// After gnss_reset_rejections GNSS positions in a row failed the gate, the filter no
+  /// longer believes the receiver (its covariance is too small for its own error): reset
+  /// position (and velocity, when the fix has it) to the fix, their covariance to the fix's,
+  /// with no correlation to the other states; attitude and IMU errors are kept. Counted as
+  /// "gnss_reset" (used = number of resets).
+  void ResetToGnss(const GnssSample& g, const Eigen::Vector3d& sigma_pos_m, const Eigen::Vector3d* sigma_vel_mps) {
+    const NavState& s = strapdown_.state();
+    const Eigen::Matrix3d R_n_b = s.q_n_b.toRotationMatrix();
+    const Eigen::Vector3d lever_n = R_n_b * cfg_.installation.antenna_lever_arm_b_m;
+    const double antenna[3] = {g.lat_rad, g.lon_rad, g.h_m};
+    const double pos[3] = {s.lat_rad, s.lon_rad, s.h_m};
+    Eigen::Vector3d ins_minus_fix_ned;
+    PositionMinus(pos, antenna, ins_minus_fix_ned.data());
+    Eigen::VectorXd dx = Eigen::VectorXd::Zero(n_);
+    dx.segment<3>(err::kPos) = -(ins_minus_fix_ned + lever_n);
+    if (sigma_vel_mps != nullptr) {
+      const Eigen::Vector3d v_antenna = s.v_n_mps + R_n_b * omega_ib_b_.cross(cfg_.installation.antenna_lever_arm_b_m);
+      dx.segment<3>(err::kVel) = g.v_n_mps - v_antenna;
+    }
+    BeginEpoch();
+    P_.middleRows(err::kPos, 6).setZero();
+    P_.middleCols(err::kPos, 6).setZero();
+    P_.diagonal().segment<3>(err::kPos) = sigma_pos_m.cwiseAbs2();
+    // Without a GNSS velocity the velocity keeps its value with 1 (m/s)^2 of variance.
+    const Eigen::Vector3d vel_var =
+        sigma_vel_mps != nullptr ? Eigen::Vector3d(sigma_vel_mps->cwiseAbs2()) : Eigen::Vector3d::Ones();
+    P_.diagonal().segment<3>(err::kVel) = vel_var;
+    const InsState corrected = ApplyCorrection(Nominal(), dx);
+    strapdown_.SetState(corrected.nav);
+    epoch_dx_ += dx;
+    ++counts_[kGnssReset].used;
   }
 
   void ProcessMag(const MagSample& sample) {
@@ -354,6 +395,7 @@ class NavigationFilter {
   // Measurement streams.
   std::size_t gi_ = 0, mi_ = 0, bi_ = 0;
   bool gnss_seen_ = false;
+  int gnss_rejected_in_row_ = 0;
   double last_mag_t_s_ = -INFINITY;
   double last_zupt_t_s_ = -INFINITY;
   std::optional<double> baro_offset_m_;

@@ -21,6 +21,7 @@
 
 #include "core/io/input_error.h"
 #include "core/io/open.h"
+#include "core/earth.h"
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
@@ -694,6 +695,42 @@ TEST(GnssInsFilter, HeadingFromGnssVelocity) {
             r.inputs.gnss.size() - 1);  // the first fix made the state
   const Rms f = RmsErrors(result.filter, r.truth, kConvergence_s);
   ExpectSeedAccuracy(f, "filter from the GNSS velocity");
+}
+
+
+TEST(GnssInsFilter, ResetsToGnssAfterRejectionsInARow) {
+  // From t = 100 s every fix is 200 m north of the truth (a receiver that changed datum):
+  // the 0.9999 gate rejects the first ones; after gnss_reset_rejections in a row the
+  // filter resets its position to the fixes and follows them. Without the reset it
+  // rejects every later fix and keeps navigating on the IMU alone.
+  const SimRecord& r = PresetRecord("mems-gps-mag-maneuver");
+  Inputs shifted = r.inputs;
+  constexpr double kStep_m = 200.0;
+  constexpr double kStepAt_s = 100.0;
+  for (GnssSample& g : shifted.gnss) {
+    if (g.t_s >= kStepAt_s) g.lat_rad += kStep_m / (wgs84::MeridianRadius(g.lat_rad) + g.h_m);
+  }
+  GnssInsConfig c = MemsConfig(r);
+  c.filter.gate_probability = 0.9999;
+  c.filter.gnss_reset_rejections = 10;
+  const FilterResult with_reset = RunFilter(shifted, c, false, {}, nullptr);
+  c.filter.gnss_reset_rejections = 0;
+  const FilterResult without = RunFilter(shifted, c, false, {}, nullptr);
+
+  const auto north_offset_at_end = [&](const FilterResult& result) {
+    const NavState& end = result.filter.epochs.back().state.nav;
+    return CompareNav(end, TruthAt(r.truth, end.t_s)).pos_ned_m.x();
+  };
+  // With the reset: one reset (or a few while the velocity settles), and the end position
+  // on the shifted fixes to the 4.25 m GNSS noise (10 m: a few sigma of one fix).
+  EXPECT_GE(with_reset.filter.counts.at("gnss_reset").used, 1u);
+  EXPECT_LE(with_reset.filter.counts.at("gnss_reset").used, 5u);
+  EXPECT_NEAR(north_offset_at_end(with_reset), kStep_m, 10.0);
+  // Without: no reset, every fix after the step rejected (1150 of the 1651 epochs are at
+  // or after 100 s), far from the fixes at the end.
+  EXPECT_EQ(without.filter.counts.at("gnss_reset").used, 0u);
+  EXPECT_GT(without.filter.counts.at("gnss_position").rejected, 1100u);
+  EXPECT_LT(north_offset_at_end(without), kStep_m - 100.0);
 }
 
 }  // namespace
