@@ -408,10 +408,12 @@ void BatchSmoother::AddMag() {
   const MagConfig& mc = cfg_.mag;
   if (mc.mode == MagConfig::Mode::kOff || in_.mag.empty()) return;
   const std::vector<long> nearest = AssociateNearest(in_.mag, states_);
+  // The calibrated samples rotated into the body axes at their states' epochs.
+  std::vector<std::pair<std::size_t, Eigen::Vector3d>> samples;
   double last_used_s = -INFINITY;
   for (std::size_t i = 0; i < states_.size(); ++i) {
     if (nearest[i] < 0) continue;
-    BatchState& s = states_[i];
+    const BatchState& s = states_[i];
     const MagSample& sample = in_.mag[static_cast<std::size_t>(nearest[i])];
     if (sample.t_s - last_used_s < mc.min_interval_s - kTimeEps_s) continue;
     // The calibrated field in the body axes at the state epoch.
@@ -426,14 +428,32 @@ void BatchSmoother::AddMag() {
       ++counts_[kMag].rejected;
       continue;
     }
+    samples.emplace_back(i, m);
+    last_used_s = sample.t_s;
+  }
+  // kHeading: the reference field (MagHeading's H0 and dip direction) is the mean of the
+  // samples rotated into NED with the initial attitudes (the filter's rule, with
+  // the whole record; docs/gnss-ins.md, "Magnetometer modes").
+  Eigen::Vector3d field_sum_uT = Eigen::Vector3d::Zero();
+  for (const auto& [i, m] : samples) field_sum_uT += states_[i].initial.nav.q_n_b * m;
+  const Eigen::Vector3d mean_field_uT = field_sum_uT / std::max<std::size_t>(samples.size(), 1);
+  for (const auto& [i, m] : samples) {
+    BatchState& s = states_[i];
     ceres::CostFunction* cost = nullptr;
     switch (mc.mode) {
       case MagConfig::Mode::kVector:
         cost = MagVector::Create(m, mc.field_ned_uT, mc.noise_uT);
         break;
-      case MagConfig::Mode::kHeading:
-        cost = MagHeading::Create(m, mc.declination_rad, mc.heading_std_rad);
+      case MagConfig::Mode::kHeading: {
+        const double h0_uT = mean_field_uT.head<2>().norm();
+        if (!(h0_uT > 0.0)) {
+          ++counts_[kMag].rejected;  // a vertical mean field: no heading
+          continue;
+        }
+        cost = MagHeading::Create(MagHeading::RemoveDipNoise(m, s.initial.nav.q_n_b, mean_field_uT),
+                                  mc.declination_rad, mc.heading_std_rad, h0_uT);
         break;
+      }
       case MagConfig::Mode::kHeading2Axis: {
         const Eigen::Vector3d rpy = EulerFromQuat<double>(s.initial.nav.q_n_b);
         if (!(std::abs(rpy[0]) < mc.max_tilt_rad && std::abs(rpy[1]) < mc.max_tilt_rad)) {
@@ -447,7 +467,6 @@ void BatchSmoother::AddMag() {
         return;
     }
     problem_->AddResidualBlock(cost, nullptr, s.q.data());
-    last_used_s = sample.t_s;
     ++counts_[kMag].used;
   }
 }

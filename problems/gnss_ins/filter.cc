@@ -279,9 +279,23 @@ class NavigationFilter {
       case MagConfig::Mode::kVector:
         cost.reset(MagVector::Create(m, mc.field_ned_uT, mc.noise_uT));
         break;
-      case MagConfig::Mode::kHeading:
-        cost.reset(MagHeading::Create(m, mc.declination_rad, mc.heading_std_rad));
+      case MagConfig::Mode::kHeading: {
+        // The reference field (H0 and the dip direction of MagHeading; docs/gnss-ins.md,
+        // "Magnetometer modes"): the mean of the samples so far rotated into NED with the
+        // nominal attitudes. The reference attitude is the nominal one.
+        const Eigen::Quaterniond& q = strapdown_.state().q_n_b;
+        heading_field_sum_uT_ += q * m;
+        ++heading_field_count_;
+        const Eigen::Vector3d mean_uT = heading_field_sum_uT_ / static_cast<double>(heading_field_count_);
+        const double h0_uT = mean_uT.head<2>().norm();
+        if (!(h0_uT > 0.0)) {
+          ++counts_[kMag].rejected;  // a vertical mean field: no heading
+          return;
+        }
+        cost.reset(MagHeading::Create(MagHeading::RemoveDipNoise(m, q, mean_uT), mc.declination_rad,
+                                      mc.heading_std_rad, h0_uT));
         break;
+      }
       case MagConfig::Mode::kHeading2Axis: {
         const Eigen::Vector3d rpy = EulerFromQuat<double>(strapdown_.state().q_n_b);
         if (!(std::abs(rpy[0]) < mc.max_tilt_rad && std::abs(rpy[1]) < mc.max_tilt_rad)) {
@@ -397,6 +411,8 @@ class NavigationFilter {
   bool gnss_seen_ = false;
   int gnss_rejected_in_row_ = 0;
   double last_mag_t_s_ = -INFINITY;
+  Eigen::Vector3d heading_field_sum_uT_ = Eigen::Vector3d::Zero();  ///< kHeading: sum of R m_b
+  std::size_t heading_field_count_ = 0;
   double last_zupt_t_s_ = -INFINITY;
   std::optional<double> baro_offset_m_;
 };

@@ -77,14 +77,19 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
     if (!soft || !soft.IsSequence() || soft.size() != 3) {
       throw std::runtime_error("errors.yaml: mag.soft_iron is not a 3x3 matrix");
     }
-    const double noise_uT = mag["noise_uT"].as<double>();
+    const double noise_uT = std::max(0.3, 3.0 * mag["noise_uT"].as<double>());
+    const Eigen::Vector3d field_ned_uT = VecFrom(mag["field_ned_uT"], "mag.field_ned_uT");
+    // The heading modes' std: the same per-axis noise over the horizontal intensity
+    // (docs/gnss-ins.md, "Magnetometer modes").
+    const double heading_std_deg = noise_uT / field_ned_uT.head<2>().norm() * kRadToDegS;
     y << "mag:\n"
          "  mode: " << mag_mode << "\n"
-         "  field: {field_ned_uT: " << Vec(VecFrom(mag["field_ned_uT"], "mag.field_ned_uT")) << "}\n"
+         "  field: {field_ned_uT: " << Vec(field_ned_uT) << "}\n"
          "  hard_iron_uT: " << Vec(VecFrom(mag["hard_iron_uT"], "mag.hard_iron_uT")) << "\n"
          "  soft_iron: [" << Vec(VecFrom(soft[0], "mag.soft_iron")) << ", " << Vec(VecFrom(soft[1], "mag.soft_iron"))
       << ", " << Vec(VecFrom(soft[2], "mag.soft_iron")) << "]\n"
-         "  noise_uT: " << Num(std::max(0.3, 3.0 * noise_uT)) << "\n";
+         "  noise_uT: " << Num(noise_uT) << "\n"
+         "  heading_std_deg: " << Num(heading_std_deg) << "\n";
   }
   y << "filter:\n"
        "  scale_factors: true\n";

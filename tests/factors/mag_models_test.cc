@@ -2,7 +2,8 @@
 // estimate too large by d gives +d / sigma, also tilted; wrapping across +-pi; the 2-axis
 // form equals the 3-axis form when level), tangent-space Jacobians (through Linearize)
 // against central differences at identity, a tiny perturbation and a random attitude, and
-// the constructors' checks.
+// the constructors' checks; MagHeading's behaviour under sample noise (no bias about
+// magnetic east, no information about the field axis after RemoveDipNoise).
 #include "factors/mag_heading.h"
 #include "factors/mag_vector.h"
 
@@ -186,7 +187,7 @@ TEST(MagHeading, ZeroForTrueAttitudeAndPlusDForHeadingTooLarge) {
     SCOPED_TRACE(euler.transpose());
     const Eigen::Quaterniond q = QuatFromEuler(euler.x(), euler.y(), euler.z());
     const Eigen::Vector3d m_b = DcmFromQuat(q).transpose() * m_n;
-    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, declination, sigma));
+    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, declination, sigma, 20.0));  // H0 = Field's horizontal
     EXPECT_NEAR(Eval1(*f, q), 0.0, 1e-12);  // atan2 rounding ~1e-16 rad / 0.02
     // Same roll and pitch, yaw larger by d: R_est = Rz(d) R_true.
     for (const double d : {0.01, -0.2, 1.5}) {
@@ -203,7 +204,7 @@ TEST(MagHeading, WrapsAcrossPlusMinusPi) {
   const Eigen::Vector3d m_n = Field(declination);
   const Eigen::Quaterniond q = QuatFromEuler(0.0, 0.0, 0.5);
   const std::unique_ptr<ceres::CostFunction> f(
-      MagHeading::Create(DcmFromQuat(q).transpose() * m_n, declination, sigma));
+      MagHeading::Create(DcmFromQuat(q).transpose() * m_n, declination, sigma, 20.0));
   const Eigen::Quaterniond q_est = QuatFromEuler(0.0, 0.0, 0.5 + 20.0 * kDeg);
   EXPECT_NEAR(Eval1(*f, q_est) * sigma, 20.0 * kDeg, 1e-12);
   const Eigen::Quaterniond q_est2 = QuatFromEuler(0.0, 0.0, 0.5 - 20.0 * kDeg);
@@ -214,9 +215,78 @@ TEST(MagHeading, TangentJacobianMatchesCentralDifferences) {
   for (const State& s : States()) {
     SCOPED_TRACE(s.name);
     const Eigen::Vector3d m_b = DcmFromQuat(s.q_n_b).transpose() * Field(0.2) + Eigen::Vector3d(0.5, -1.0, 0.3);
-    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, 0.1, 0.05));
+    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, 0.1, 0.05, 25.0));
     ExpectTangentJacobiansMatch(*f, {{Std(s.q_n_b), &kAttitudeManifold, kAttStep}}, kJacobianTol);
   }
+}
+
+// Errors in variables: the noisy sample is in the residual and in its Jacobian. Over many
+// noisy samples at the true attitude, the whitened J^T r must average to zero (a nonzero
+// mean is a systematic pull of every update). Field: D = 0, H = 20, Z = 45 uT (I = 66 deg),
+// per-axis noise 0.5 uT, sigma = noise / H; tangent column 1 is the rotation about
+// (magnetic) east, which tilts the field towards the horizontal.
+TEST(MagHeading, UnbiasedAboutMagneticEastUnderSampleNoise) {
+  const double noise_uT = 0.5, h_uT = 20.0, sigma = noise_uT / h_uT;
+  const Eigen::Vector3d m_n = Field(0.0, h_uT);
+  const Eigen::Quaterniond q = QuatFromEuler(0.1, -0.2, 0.8);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, noise_uT);
+  const int n = 20000;
+  double sum_jr = 0.0, sum_bare = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d m_b = DcmFromQuat(q).transpose() * m_n + Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m_b, 0.0, sigma, h_uT));
+    const Linearization lin = LinearizeAt(*f, {{Std(q), &kAttitudeManifold, 0.0}});
+    sum_jr += lin.jacobians[0](0, 1) * lin.residual[0];
+    // The bare angle a / sigma (the former model) from the same sample, by hand: J_east =
+    // -m_D m_E / (h^2 sigma) (a rotation phi about east moves m_N by phi m_D).
+    const Eigen::Vector3d mn = DcmFromQuat(q) * m_b;
+    const double h2 = mn.head<2>().squaredNorm();
+    sum_bare += (-mn.z() * mn.y() / (h2 * sigma)) * (std::atan2(mn.y(), mn.x()) / sigma);
+  }
+  // Bare angle: E[J r] = -Z E[m_E^2] / (H^3 sigma^2) = -(Z / H) (noise / (H sigma))^2 =
+  // -2.25 per sample (per rad). Each term has std ~ (Z / H) = 2.25, so the mean of 20000
+  // has std ~0.016: the new model's mean is within 0.1 of zero, the bare angle's within
+  // 0.1 of -2.25.
+  EXPECT_NEAR(sum_jr / n, 0.0, 0.1);
+  EXPECT_NEAR(sum_bare / n, -45.0 / 20.0, 0.1);
+}
+
+// The second effect: the null space of a function of R m_b is the rotation about the
+// measured direction, so the noise along the dip direction gives each sample a Jacobian
+// component about the true field axis (~ noise / (H sigma) = 1 whitened, per rad).
+// RemoveDipNoise with the true attitude and field takes it out: what is left is second
+// order (~ noise^2).
+TEST(MagHeading, RemoveDipNoiseLeavesNoInformationAboutTheFieldAxis) {
+  const double noise_uT = 0.5, h_uT = 20.0, sigma = noise_uT / h_uT, declination = 0.3;
+  const Eigen::Vector3d m_n = Field(declination, h_uT);
+  const Eigen::Vector3d axis = m_n.normalized();
+  const Eigen::Quaterniond q = QuatFromEuler(-0.15, 0.1, 2.0);
+  std::mt19937 rng(12);
+  std::normal_distribution<double> normal(0.0, noise_uT);
+  double sum_sq_raw = 0.0, sum_sq_clean = 0.0;
+  const int n = 2000;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::Vector3d m_b = DcmFromQuat(q).transpose() * m_n + Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d clean = MagHeading::RemoveDipNoise(m_b, q, m_n);
+    // The removed part is along R^T d, d in the field's vertical plane, perpendicular to it.
+    const Eigen::Vector3d removed_n = DcmFromQuat(q) * (m_b - clean);
+    EXPECT_LT(std::abs(removed_n.dot(axis)), 1e-12);
+    EXPECT_LT(std::abs(removed_n.dot(Eigen::Vector3d(-std::sin(declination), std::cos(declination), 0.0))), 1e-12);
+    for (const auto& [m, sum] : {std::make_pair(m_b, &sum_sq_raw), std::make_pair(clean, &sum_sq_clean)}) {
+      const std::unique_ptr<ceres::CostFunction> f(MagHeading::Create(m, declination, sigma, h_uT));
+      const double j_axis = LinearizeAt(*f, {{Std(q), &kAttitudeManifold, 0.0}}).jacobians[0].row(0).dot(axis);
+      *sum += j_axis * j_axis;
+    }
+  }
+  // Raw: E[j^2] = (noise / (H sigma))^2 = 1 (rad^-2 per sample, whitened). Clean: the
+  // second-order rest, (noise / H)^2 (Z / H)^2 / sigma^2 ~ 3e-3 at most; 0.05 separates.
+  EXPECT_NEAR(sum_sq_raw / n, 1.0, 0.15);
+  EXPECT_LT(sum_sq_clean / n, 0.05);
+  // Degenerate references leave the sample unchanged.
+  const Eigen::Vector3d m_b(10.0, -3.0, 40.0);
+  EXPECT_EQ(MagHeading::RemoveDipNoise(m_b, q, Eigen::Vector3d::Zero()), m_b);
+  EXPECT_EQ(MagHeading::RemoveDipNoise(m_b, q, Eigen::Vector3d(0.0, 0.0, 50.0)), m_b);
 }
 
 TEST(MagHeading2Axis, MatchesMagHeadingWhenLevel) {
@@ -224,7 +294,7 @@ TEST(MagHeading2Axis, MatchesMagHeadingWhenLevel) {
   const Eigen::Vector3d m_n = Field(declination);
   for (const double yaw_true : {0.0, 1.2, -2.9, M_PI}) {
     const Eigen::Vector3d m_b = DcmFromQuat(QuatFromEuler(0.0, 0.0, yaw_true)).transpose() * m_n;
-    const std::unique_ptr<ceres::CostFunction> f3(MagHeading::Create(m_b, declination, sigma));
+    const std::unique_ptr<ceres::CostFunction> f3(MagHeading::Create(m_b, declination, sigma, 20.0));
     const std::unique_ptr<ceres::CostFunction> f2(MagHeading2Axis::Create(m_b.x(), m_b.y(), declination, sigma));
     for (const double d : {0.0, 0.05, -0.6, 2.5}) {
       SCOPED_TRACE("yaw " + std::to_string(yaw_true) + " d " + std::to_string(d));
@@ -255,10 +325,11 @@ TEST(MagHeading2Axis, MeasuredHeadingAndTangentJacobian) {
 
 TEST(MagHeading, RejectsBadSigma) {
   for (const double bad : {0.0, -1.0, kNaN, kInf}) {
-    EXPECT_THROW(MagHeading(Field(0.0), 0.0, bad), std::invalid_argument) << bad;
+    EXPECT_THROW(MagHeading(Field(0.0), 0.0, bad, 20.0), std::invalid_argument) << bad;
+    EXPECT_THROW(MagHeading(Field(0.0), 0.0, 0.1, bad), std::invalid_argument) << bad;
     EXPECT_THROW(MagHeading2Axis(20.0, 1.0, 0.0, bad), std::invalid_argument) << bad;
   }
-  EXPECT_THROW(MagHeading(Field(0.0), kNaN, 0.1), std::invalid_argument);
+  EXPECT_THROW(MagHeading(Field(0.0), kNaN, 0.1, 20.0), std::invalid_argument);
   EXPECT_THROW(MagHeading2Axis(kInf, 1.0, 0.0, 0.1), std::invalid_argument);
 }
 
