@@ -14,57 +14,20 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/apps/cli_util.h"
+
 #include "tests/test_data.h"
 
 namespace navtwin {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
+using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
-std::string TempDir() {
-  std::string tmpl = ::testing::TempDir() + "navtwin_cli_XXXXXX";
-  char* dir = ::mkdtemp(tmpl.data());
-  EXPECT_NE(dir, nullptr);
-  return tmpl;
-}
 
-RunResult Navtwin(const std::string& args) {
-  static const std::string dir = TempDir();
-  const std::string out = dir + "/stdout", err = dir + "/stderr";
-  const std::string cmd = std::string(NAVTWIN_BIN_DIR) + "/navtwin " + args + " >" + out + " 2>" + err;
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadAll(out);
-  r.err = ReadAll(err);
-  return r;
-}
 
-bool Exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0;
-}
 
-// The number after "key": in a flat piece of JSON (enough for these fixed outputs).
-double JsonNumberAfter(const std::string& json, const std::string& anchor, const std::string& key) {
-  const std::size_t at = json.find(anchor);
-  if (at == std::string::npos) return NAN;
-  std::smatch m;
-  const std::string rest = json.substr(at);
-  if (!std::regex_search(rest, m, std::regex("\"" + key + "\":(-?[0-9.eE+-]+)"))) return NAN;
-  return std::stod(m[1]);
-}
+
 
 TEST(Cli, HelpListsSubcommandsAndFlags) {
   const RunResult main_help = Navtwin("--help");
@@ -91,7 +54,7 @@ TEST(Cli, MisuseExitsWithUsageCode) {
 }
 
 TEST(Cli, InfoNamesTheLineWhereTimeGoesBackwards) {
-  const std::string path = TempDir() + "/imu.txt";
+  const std::string path = MakeTempDir("cli") + "/imu.txt";
   {
     std::ofstream f(path);
     f.precision(12);
@@ -107,7 +70,7 @@ TEST(Cli, InfoNamesTheLineWhereTimeGoesBackwards) {
 }
 
 TEST(Cli, DemoNavigatesWithSmallErrorsAndWritesTheSolution) {
-  const std::string dir = TempDir();
+  const std::string dir = MakeTempDir("cli");
   const RunResult r = Navtwin("ins --demo --demo_duration_s 60 --out " + dir + " --format=json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // Exact increments through 17-digit text files: micrometres and 1e-10 deg over 60 s
@@ -125,7 +88,7 @@ TEST(Cli, DemoNavigatesWithSmallErrorsAndWritesTheSolution) {
 }
 
 TEST(Cli, BadInputLeavesNoPartialOutput) {
-  const std::string dir = TempDir();
+  const std::string dir = MakeTempDir("cli");
   const std::string imu = dir + "/imu.txt", nav = dir + "/init.nav";
   {
     std::ofstream f(imu);
@@ -160,7 +123,7 @@ TEST(Cli, InfoOnRealUlogShowsImuAndGpsRates) {
 }
 
 TEST(Cli, ConvertRoundTripsThroughCsvExactly) {
-  const std::string dir = TempDir();
+  const std::string dir = MakeTempDir("cli");
   ASSERT_EQ(Navtwin("ins --demo --demo_duration_s 5 --out " + dir).exit_code, 0);
   const RunResult to_csv = Navtwin("convert --in " + dir + "/imu.txt --out " + dir + "/imu.csv");
   ASSERT_EQ(to_csv.exit_code, 0) << to_csv.err;
@@ -183,7 +146,7 @@ TEST(Cli, ConvertRoundTripsThroughCsvExactly) {
 TEST(Cli, ConvertsRealUlogImuToKfgins) {
   const std::string path = testing::DataPath("px4-ulog/ekf_failure.ulg");
   NAVTWIN_REQUIRE_DATA(path);
-  const std::string out = TempDir() + "/imu.txt";
+  const std::string out = MakeTempDir("cli") + "/imu.txt";
   const RunResult r = Navtwin("convert --in " + path + " --out " + out);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const RunResult info = Navtwin("info " + out + " --format=json");
@@ -196,7 +159,7 @@ TEST(Cli, ConvertsRealUlogImuToKfgins) {
 // The simulator issue's acceptance: a perfect one-hour navigation-grade record, navigated
 // by `navtwin ins` from its first truth record, ends within 1 cm and 1e-4 deg of the truth.
 TEST(Cli, PerfectNavGradeHourRoundTripsThroughIns) {
-  const std::string dir = TempDir();
+  const std::string dir = MakeTempDir("cli");
   const RunResult sim =
       Navtwin("simulate --scenario nav-grade-vehicle-1h --perfect --seed 3 --out " + dir + " --format=json");
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
@@ -216,7 +179,7 @@ TEST(Cli, PerfectNavGradeHourRoundTripsThroughIns) {
 }
 
 TEST(Cli, AllanReadsBackTheSimulatedNoise) {
-  const std::string dir = TempDir();
+  const std::string dir = MakeTempDir("cli");
   const std::string yaml = dir + "/static.yaml";
   std::ofstream(yaml) << "name: static-noise\nstart: {lat_deg: 45, lon_deg: 0, h_m: 0}\n"
                          "trajectory:\n  segments:\n    - {kind: static, duration_s: 1800}\n"

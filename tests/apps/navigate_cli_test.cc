@@ -18,46 +18,19 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/apps/cli_util.h"
+
 #include "core/earth.h"
 
 namespace navtwin {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
-std::string ReadAll(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
-std::string MakeTempDir(const std::string& tag) {
-  std::string tmpl = ::testing::TempDir() + "navtwin_nav_" + tag + "_XXXXXX";
-  EXPECT_NE(::mkdtemp(tmpl.data()), nullptr);
-  return tmpl;
-}
 
-RunResult Navtwin(const std::string& args) {
-  static const std::string dir = MakeTempDir("io");
-  const std::string out = dir + "/stdout", err = dir + "/stderr";
-  const std::string cmd = std::string(NAVTWIN_BIN_DIR) + "/navtwin " + args + " >" + out + " 2>" + err;
-  const int status = std::system(cmd.c_str());
-  RunResult r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = ReadAll(out);
-  r.err = ReadAll(err);
-  return r;
-}
 
-bool Exists(const std::string& path) {
-  struct stat st;
-  return ::stat(path.c_str(), &st) == 0;
-}
+
 
 /// Entries of a folder other than . and .. (none when it does not exist).
 std::vector<std::string> Entries(const std::string& dir) {
@@ -72,15 +45,6 @@ std::vector<std::string> Entries(const std::string& dir) {
   return names;
 }
 
-// The number after "key": following `anchor` in a piece of JSON.
-double JsonNumberAfter(const std::string& json, const std::string& anchor, const std::string& key) {
-  const std::size_t at = json.find(anchor);
-  if (at == std::string::npos) return NAN;
-  std::smatch m;
-  const std::string rest = json.substr(at);
-  if (!std::regex_search(rest, m, std::regex("\"" + key + "\":(-?[0-9.eE+-]+)"))) return NAN;
-  return std::stod(m[1]);
-}
 
 // ---------------------------------------------------------------------------------------
 // A tiny record: 20 s of a level, north-facing, static IMU at 100 Hz (gravity and Earth
