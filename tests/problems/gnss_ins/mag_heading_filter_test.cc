@@ -21,48 +21,20 @@
 #include "core/sim/simulator.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/ins/nav_error.h"
+#include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
-template <typename Sample, typename Reader>
-std::vector<Sample> ReadAll(const std::unique_ptr<Reader>& reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
-
-Eigen::Vector3d Vec3(const YAML::Node& n) {
-  return Eigen::Vector3d(n[0].as<double>(), n[1].as<double>(), n[2].as<double>());
-}
-
-NavState TruthAt(const std::vector<NavState>& truth, double t_s) {
-  auto it = std::lower_bound(truth.begin(), truth.end(), t_s,
-                             [](const NavState& s, double t) { return s.t_s < t; });
-  if (it == truth.end()) return truth.back();
-  if (std::abs(it->t_s - t_s) < 1e-9 || it == truth.begin()) return *it;
-  return InterpolateNav(*(it - 1), *it, t_s);
-}
+using namespace test_records;  // SimulateRecord, Vec3, TruthAt
 
 TEST(MagHeadingFilter, LevelFlightHonestSigmaStaysAccurateAndConsistent) {
   // Simulate the preset (seed 1) and read it as a user would.
-  std::string dir = ::testing::TempDir() + "navtwin_magheading_XXXXXX";
-  ASSERT_NE(::mkdtemp(dir.data()), nullptr);
-  sim::SimulationOptions options;
-  options.seed = 1;
-  sim::Simulate(sim::LoadScenario("mems-gps-mag-level-flight"), options, dir);
-  Inputs in;
-  in.paths.imu = dir + "/imu.txt";
-  in.imu = ReadAll<ImuSample>(OpenImu(in.paths.imu));
-  in.paths.gnss = dir + "/gnss.txt";
-  in.gnss = ReadAll<GnssSample>(OpenGnss(in.paths.gnss));
-  in.paths.mag = dir + "/mag.csv";
-  in.mag = ReadAll<MagSample>(OpenMag(in.paths.mag));
-  const std::vector<NavState> truth = ReadAll<NavState>(OpenNav(dir + "/truth.nav"));
-  const NavState init = ReadAll<NavState>(OpenNav(dir + "/init.nav")).front();
-  const YAML::Node errors = YAML::LoadFile(dir + "/errors.yaml");
-  std::filesystem::remove_all(dir);
+  const SimRecord r = SimulateRecord(sim::LoadScenario("mems-gps-mag-level-flight"), 1);
+  const Inputs& in = r.inputs;
+  const std::vector<NavState>& truth = r.truth;
+  const NavState& init = r.init;
+  const YAML::Node& errors = r.errors;
 
   // The seed-001 MEMS configuration of filter_test.cc (MemsConfig): doubled ARW and VRW,
   // the preset's bias sigmas, 1 h Gauss-Markov; tilt 0.5 deg, heading 10 deg initial std.

@@ -23,6 +23,7 @@
 #include "problems/gnss_ins/filter.h"
 #include "problems/ins/nav_error.h"
 #include "solvers/eskf.h"
+#include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
 namespace {
@@ -57,18 +58,6 @@ constexpr int kRuns = 50;
 constexpr double kDegPerHour = kDegToRad / 3600.0;
 constexpr double kMicroG = 9.80665e-6;
 
-template <typename Sample, typename Reader>
-std::vector<Sample> ReadAll(const std::unique_ptr<Reader>& reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader->Next(&s)) out.push_back(s);
-  return out;
-}
-
-Eigen::Vector3d Vec3(const YAML::Node& n) {
-  return Eigen::Vector3d(n[0].as<double>(), n[1].as<double>(), n[2].as<double>());
-}
-
 struct RunNees {
   std::vector<double> filter;  ///< NEES at each check epoch
   std::vector<double> rts;
@@ -77,24 +66,15 @@ struct RunNees {
 /// One Monte Carlo run: simulate with `seed`, start from the truth perturbed by a draw from
 /// the initial covariance, and compute the NEES at the check epochs.
 RunNees OneRun(const sim::Scenario& scenario, std::uint64_t seed, const std::vector<double>& check_s) {
-  std::string dir = ::testing::TempDir() + "navtwin_nees_XXXXXX";
-  if (::mkdtemp(dir.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-  sim::SimulationOptions options;
-  options.seed = seed;
-  sim::Simulate(scenario, options, dir);
-  Inputs in;
-  in.paths = {dir + "/imu.txt", dir + "/gnss.txt", dir + "/mag.csv", ""};
-  in.imu = ReadAll<ImuSample>(OpenImu(in.paths.imu));
-  in.gnss = ReadAll<GnssSample>(OpenGnss(in.paths.gnss));
-  in.mag = ReadAll<MagSample>(OpenMag(in.paths.mag));
-  const std::vector<NavState> truth = ReadAll<NavState>(OpenNav(dir + "/truth.nav"));
-  const YAML::Node errors = YAML::LoadFile(dir + "/errors.yaml");
-  std::filesystem::remove_all(dir);
+  const test_records::SimRecord r = test_records::SimulateRecord(scenario, seed);
+  const Inputs& in = r.inputs;
+  const std::vector<NavState>& truth = r.truth;
+  const YAML::Node& errors = r.errors;
 
   // The true IMU errors of this run (constant biases).
   ImuErrors true_imu;
-  true_imu.bg_radps = Vec3(errors["imu"]["errors"]["gyro"]["bias_deg_h"]) * kDegPerHour;
-  true_imu.ba_mps2 = Vec3(errors["imu"]["errors"]["accel"]["bias_ug"]) * kMicroG;
+  true_imu.bg_radps = test_records::Vec3(errors["imu"]["errors"]["gyro"]["bias_deg_h"]) * kDegPerHour;
+  true_imu.ba_mps2 = test_records::Vec3(errors["imu"]["errors"]["accel"]["bias_ug"]) * kMicroG;
 
   // The model of the scenario's sensors, taken honestly from its parameters.
   GnssInsConfig c;
@@ -105,7 +85,7 @@ RunNees OneRun(const sim::Scenario& scenario, std::uint64_t seed, const std::vec
   c.imu_noise.correlation_time_s = std::numeric_limits<double>::infinity();  // constants
   c.installation.antenna_lever_arm_b_m = Eigen::Vector3d(0.3, 0.0, -0.5);
   c.mag.mode = MagConfig::Mode::kVector;
-  c.mag.field_ned_uT = Vec3(errors["mag"]["field_ned_uT"]);
+  c.mag.field_ned_uT = test_records::Vec3(errors["mag"]["field_ned_uT"]);
   c.mag.noise_uT = 0.3;
   c.init.std.pos_ned_m = Eigen::Vector3d(3.0, 3.0, 5.0);
   c.init.std.vel_ned_mps.setConstant(0.3);
