@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace navtwin::signal {
@@ -15,12 +16,23 @@ std::vector<double> Normalise(std::vector<double> num) {
   return num;
 }
 
+// A number for messages: up to four significant digits, no trailing zeros.
+std::string Compact(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.4g", v);
+  return buffer;
+}
+
 int ClampLag(int max_lag, int n) { return std::max(0, std::min(max_lag, n - 1)); }
 
-// Vertex of the parabola through (t-1, r[t-1]), (t, r[t]), (t+1, r[t+1]).
-double ParabolicPeak(const std::vector<double>& r, int t) {
-  if (t <= 0 || t + 1 >= static_cast<int>(r.size())) return t;
-  const double a = r[t - 1], b = r[t], c = r[t + 1];
+// Lag-normalised r(t) k / (k - t): equation 2's (k - t)/k taper would pull every
+// interpolated peak towards shorter lags.
+double Normalised(const std::vector<double>& r, int t, int k) { return r[t] * k / static_cast<double>(k - t); }
+
+// Vertex of the parabola through the lag-normalised values at t - 1, t, t + 1.
+double ParabolicPeak(const std::vector<double>& r, int t, int k) {
+  if (t <= 0 || t + 1 >= static_cast<int>(r.size()) || t + 1 >= k) return t;
+  const double a = Normalised(r, t - 1, k), b = Normalised(r, t, k), c = Normalised(r, t + 1, k);
   const double den = a - 2.0 * b + c;
   if (!(den < 0.0)) return t;
   return t + std::clamp(0.5 * (a - c) / den, -0.5, 0.5);
@@ -88,8 +100,7 @@ std::vector<int> FindPeaks(const std::vector<double>& r, int n_samples, const Pe
   const int w = std::max(1, options.half_width);
   std::vector<int> candidates;
   for (int t = std::max(1, options.min_lag); t <= last; ++t) {
-    const double normalised = r[t] * n_samples / static_cast<double>(n_samples - t);
-    if (!(normalised >= options.threshold)) continue;
+    if (!(Normalised(r, t, n_samples) >= options.threshold)) continue;
     bool is_max = true;
     for (int d = -w; d <= w && is_max; ++d) {
       const int u = t + d;
@@ -118,7 +129,7 @@ PeriodEstimate EstimatePeriod(const std::vector<double>& r, int n_samples, const
   PeriodEstimate out;
   out.peak_lags = FindPeaks(r, n_samples, options);
   if (out.peak_lags.empty()) {
-    out.reason = "no autocorrelation peak reaches " + std::to_string(options.threshold) +
+    out.reason = "no autocorrelation peak reaches " + Compact(options.threshold) +
                  " (lag-normalised) within " + std::to_string(static_cast<int>(r.size()) - 1) + " lags";
     return out;
   }
@@ -127,14 +138,14 @@ PeriodEstimate EstimatePeriod(const std::vector<double>& r, int n_samples, const
   out.period_samples = static_cast<int>(std::lround(out.mean_relative_lag));
   double num = 0.0, den = 0.0;
   for (int i = 0; i < count; ++i) {
-    const double lag = ParabolicPeak(r, out.peak_lags[i]);
+    const double lag = ParabolicPeak(r, out.peak_lags[i], n_samples);
     num += (i + 1) * lag;
     den += static_cast<double>(i + 1) * (i + 1);
   }
   out.refined_period_samples = num / den;
   if (out.period_samples < 1 || 2.0 * out.refined_period_samples > n_samples) {
     out.reason = "the window of " + std::to_string(n_samples) + " samples holds fewer than two periods of " +
-                 std::to_string(out.refined_period_samples) + " samples";
+                 Compact(out.refined_period_samples) + " samples";
     return out;
   }
   out.found = true;

@@ -65,7 +65,8 @@ std::vector<int> FindPeaks(const std::vector<double>& r, int n_samples, const Pe
 
 /// The disturbance period from the peak lags L1 < L2 < ...: the mean of the relative lags
 /// L1, L2 - L1, L3 - L2, ... (= L_last / count), rounded to whole samples as the seed does,
-/// and a refined fractional period from parabolic interpolation of each peak and a
+/// and a refined fractional period from parabolic interpolation of each peak (on the
+/// lag-normalised values, which equation 2's taper would bias short) and a
 /// least-squares line through (i, L_i) and the origin.
 struct PeriodEstimate {
   bool found = false;

@@ -34,16 +34,27 @@ class OnlineLeveler {
   bool Converged(double sigma_limit_rad) const;
 
  private:
+  void UpdatePeriod();
+  void ProcessBlock();
+  void PlainMeanSoFar(Eigen::Vector3d* mean_f_b_mps2, Eigen::Matrix2d* covariance) const;
+
   LevelingOptions options_;
   double rate_hz_;
   signal::RunningAutocorrelation autocorr_;
-  std::vector<Eigen::Vector3d> samples_;
+  AccelWindow window_;            ///< the samples so far (f_b_mps2 only)
+  Eigen::Vector3d sum_f_ = Eigen::Vector3d::Zero();   ///< running sums of f and f^2 (per axis)
+  Eigen::Vector3d sum_f2_ = Eigen::Vector3d::Zero();
   double block_start_ = 0.0;      ///< fractional sample index where the next block starts
   double period_samples_ = 0.0;   ///< fractional period in use (0: none yet)
   int blocks_ = 0;
+  Eigen::Vector3d block_sum_ = Eigen::Vector3d::Zero();  ///< sum of the block means (gravity)
   Eigen::Vector2d x_ = Eigen::Vector2d::Zero();  ///< roll, pitch (rad)
   Eigen::Matrix2d p_ = Eigen::Matrix2d::Zero();
 };
+
+/// d SpecificForceAtRest / d(roll, pitch) at g_mps2: the filter's measurement Jacobian H
+/// (columns roll, pitch).
+Eigen::Matrix<double, 3, 2> SpecificForceJacobian(double roll_rad, double pitch_rad, double g_mps2);
 
 /// Runs OnlineLeveler over a window (max lag = options.max_lag_fraction of it) and
 /// returns its final estimate.

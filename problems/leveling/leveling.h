@@ -81,6 +81,12 @@ struct WindowCheck {
 };
 WindowCheck CheckWindow(const AccelWindow& window, const LevelingOptions& options);
 
+/// The window without its saturated or clipped samples (as CheckWindow finds them), time
+/// tags kept (filled from rate_hz when absent); *removed = how many were left out. The
+/// batch fits its model to the rest (a clipped sample follows no sinusoid); the averaging
+/// methods cannot drop samples without breaking whole periods and keep them.
+AccelWindow WithoutSaturatedSamples(const AccelWindow& window, const LevelingOptions& options, int* removed);
+
 /// The autocorrelation period of a window (multi-channel equation 2 over all axes, lags
 /// up to max_lag_fraction of the window).
 signal::PeriodEstimate EstimateWindowPeriod(const AccelWindow& window, const LevelingOptions& options);
