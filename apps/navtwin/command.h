@@ -24,6 +24,8 @@ Command SimulateCommand();
 Command AllanCommand();
 Command NavigateCommand();
 Command SmoothCommand();
+Command LevelCommand();
+Command LevelMcCommand();
 
 /// Exit codes shared by all subcommands.
 constexpr int kExitOk = 0;

@@ -20,7 +20,8 @@ namespace {
 
 std::vector<Command> AllCommands() {
   return {InfoCommand(),     ConvertCommand(),  InsCommand(),   SimulateCommand(),
-          AllanCommand(),    NavigateCommand(), SmoothCommand()};
+          AllanCommand(),    NavigateCommand(), SmoothCommand(),  LevelCommand(),
+          LevelMcCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {

@@ -1,6 +1,8 @@
 // Online leveling: roll and pitch with a covariance, updated as samples arrive from
 // period-averaged accelerations, the period re-estimated from a running autocorrelation
-// (equation 2) as data arrive. The filter form of seed 000; docs/leveling.md.
+// (equation 2) as data arrive. The filter form of seed 000; docs/leveling.md describes the
+// period search (peak lags, then the period that best cancels in x_j - x(j - P)), the
+// blocks averaged over exactly one fractional period, and the information-form update.
 #pragma once
 
 #include <vector>
@@ -14,8 +16,9 @@ namespace navtwin::leveling {
 
 class OnlineLeveler {
  public:
-  /// rate_hz: nominal sample rate; max_lag_samples: longest autocorrelation lag kept (the
-  /// longest vibration period the filter can find is half of it).
+  /// rate_hz: nominal sample rate; max_lag_samples: longest autocorrelation lag kept. A
+  /// period is accepted once the samples hold 2.5 of them, so the longest period the
+  /// filter can find is about min(max_lag_samples - 2, samples / 2.5).
   OnlineLeveler(const LevelingOptions& options, double rate_hz, int max_lag_samples);
 
   /// Adds one specific-force sample (body FRD, m/s^2). Returns true when a whole-period
