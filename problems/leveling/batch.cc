@@ -32,6 +32,9 @@ constexpr int kScanHalfSteps = 4;
 constexpr double kSignificance = 5.0;
 /// Harmonics at or above this fraction of the sample rate alias: they are not modelled.
 constexpr double kMaxToneRateFraction = 0.45;
+/// With harmonics, f0 / 2 replaces the autocorrelation's f0 when its fit explains this many
+/// sigma^2 more (ChooseModel).
+constexpr double kHalfFundamentalMargin = 25.0;
 /// Floor of an estimated noise (m/s^2), so that a noise-free window still has weights.
 constexpr double kMinNoise_mps2 = 1e-6;
 constexpr int kMaxIterations = 30;
@@ -266,6 +269,16 @@ ModelChoice ChooseModel(const AccelWindow& window, const LevelingOptions& option
                       " harmonics modelled (higher ones alias)";
   }
   choice.start = ScanFrequency(fitter, f0_hz);
+  if (choice.harmonics >= 2) {
+    // A second harmonic stronger than the fundamental puts the first autocorrelation peak
+    // at half the period. Harmonics of f0 / 2 then include f0: same parameter count, so
+    // the half fundamental wins only when it explains clearly more than noise could
+    // (kHalfFundamentalMargin sigma^2 of sum of squares, a ~5-sigma margin).
+    const ToneFit half = ScanFrequency(fitter, 0.5 * f0_hz);
+    if (half.explained > choice.start.explained + kHalfFundamentalMargin * sigma_mps2 * sigma_mps2) {
+      choice.start = half;
+    }
+  }
   choice.frequency_free = VibrationSignificant(choice.start, options.vib_axes, sigma_mps2, n);
   if (!choice.frequency_free) {
     choice.note = "vibration not significant (fundamental below 5 sigma/sqrt(N) on every modelled axis): "

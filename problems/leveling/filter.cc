@@ -69,15 +69,16 @@ constexpr double kDoublePeriodMinPart = 0.01;
 // The fractional period within SearchHalfRange of p0 (the mean relative lag of the
 // autocorrelation peaks) that minimises the difference cost, and the cost there: an
 // estimate of the variance that is not periodic (noise, summed over the axes).
-// Why not the parabolic-peak period of signal::EstimatePeriod: equation 2 sums k - t
-// products at lag t, so a sinusoid's r(t) carries the factor (k - t)/k, which pulls the
-// interpolated peak towards short lags by about 1 / ((k - L) w^2) samples (w the angular
-// frequency per sample): for the seed's 22-24 Hz at 600 Hz, -0.14 samples on average over
-// 120 samples, -0.55 over 66 (2.5 periods). A block averaged over P + e samples leaves
-// about A sin(phi) e / P of a vibration of amplitude A (up to 0.3 deg per 1 g at
-// e = 0.14), so the filter refines. The search is exact: within each whole-sample interval
-// the minimum of N / G is at an end or where N' G - N G' = 0, a quadratic (the cubic terms
-// cancel).
+// Why not signal::EstimatePeriod's interpolated period: equation 2 sums k - t products at
+// lag t, so a sinusoid's r(t) carries the factor (k - t)/k; on the raw r it pulled each
+// interpolated peak short by 0.14 samples on average over 120 samples (0.55 over 66, the
+// 2.5 periods at which the filter starts) for the seed's 22-24 Hz at 600 Hz. EstimatePeriod
+// now interpolates the lag-normalised values, which leaves about -0.02 samples at 120, but
+// it still rests on three lags per peak. A block averaged over P + e samples leaves about
+// A sin(phi) e / P of a vibration of amplitude A (up to 0.3 deg per 1 g at e = 0.14), so
+// the filter refines on the differences, where the period is a direct minimum. The search
+// is exact: within each whole-sample interval the minimum of N / G is at an end or where
+// N' G - N G' = 0, a quadratic (the cubic terms cancel).
 struct PeriodFit {
   double period_samples = 0.0;
   double residual_variance = std::numeric_limits<double>::infinity();

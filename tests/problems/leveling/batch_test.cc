@@ -183,6 +183,26 @@ TEST(LevelingBatchTest, TwoHarmonicsOnAllAxes) {
   }
 }
 
+TEST(LevelingBatchTest, StrongSecondHarmonicFindsTheFundamental) {
+  // A second harmonic five times the fundamental puts the autocorrelation period at half
+  // the true one; the batch must still model 23.3 Hz and 46.6 Hz.
+  sim::Rng rng(19);
+  Truth truth;
+  truth.pitch_rad = 2.0 * kDegToRad;
+  truth.tones = {{0, 1, 0.2 * kG, 0.7}, {0, 2, 1.0 * kG, -1.9}};
+  const AccelWindow window = Simulate(truth, rng);
+  LevelingOptions options;
+  options.vib_tones = 2;
+  const signal::PeriodEstimate period = EstimateWindowPeriod(window, options);
+  ASSERT_TRUE(period.found) << period.reason;
+  ASSERT_LT(period.refined_period_samples, 0.6 * kRate / truth.f_hz) << "the case this test is about";
+  const BatchLevelingResult r = SolveLevelingBatch(window, options, period);
+  // The frequency to a few of its own sigmas (about 0.02 Hz here); a wrong fundamental
+  // would be off by a factor two.
+  EXPECT_NEAR(r.estimate.vib_freq_hz, truth.f_hz, 0.2);
+  EXPECT_NEAR(r.estimate.pitch_rad, truth.pitch_rad, 4.0 * r.estimate.pitch_sigma_rad);  // 4 sigma, fixed seed
+}
+
 TEST(LevelingBatchTest, NoiseFreeWindowRecoversTheVibrationExactly) {
   Truth truth;
   truth.roll_rad = 3.0 * kDegToRad;
