@@ -33,7 +33,9 @@ DEFINE_double(init_vd_mps, 0.0, "Initial down velocity, m/s");
 DEFINE_double(init_roll_deg, 0.0, "Initial roll, deg");
 DEFINE_double(init_pitch_deg, 0.0, "Initial pitch, deg");
 DEFINE_double(init_yaw_deg, NAN, "Initial yaw (heading), deg");
-DEFINE_double(start_s, NAN, "Start time, s (default: the initial record, or the first IMU interval)");
+DEFINE_double(start_s, NAN,
+              "Start time, s (ins, navigate: default the initial record, or the first IMU interval; "
+              "level: seconds after the first IMU sample, default 0)");
 DEFINE_double(end_s, INFINITY, "Stop after this time, s");
 DEFINE_double(output_rate_hz, 0.0, "Solution output rate, Hz (0: every IMU epoch)");
 DEFINE_double(hold_height_m, NAN, "Hold the height at this value (damps the unstable vertical channel)");

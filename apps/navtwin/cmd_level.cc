@@ -160,8 +160,8 @@ int RunLevel(const std::vector<std::string>& args) {
   }
   Report(check.message, "warning");
   if (check.saturated_samples > 0) {
-    std::cerr << "navtwin level: warning: every method still uses the saturated samples; their "
-                 "estimates may be biased\n";
+    std::cerr << "navtwin level: warning: the batch leaves the saturated samples out of its fit; the "
+                 "averaging methods and the filter keep them and may be biased\n";
   }
   const std::vector<leveling::LevelEstimate> methods = leveling::LevelAllMethods(window, options);
   if (FLAGS_format == "json") {
@@ -185,7 +185,8 @@ Command LevelCommand() {
           "  - window shorter than two vibration periods, or no autocorrelation peak: period_average and\n"
           "    filter level with the plain mean, the batch without tones, and each says so in its note;\n"
           "  - saturated samples (|f| >= 99.5 % of the accelerometer range, or clipping: >= 3 equal\n"
-          "    extreme values in a row): a warning on stderr with their count, axes and times;\n"
+          "    extreme values in a row): a warning on stderr with their count, axes and times; the\n"
+          "    batch leaves them out of its fit, the averaging methods keep them (biased);\n"
           "  - a moving vehicle (mean angular rate > 0.05 rad/s, or mean |f| more than 0.5 m/s^2 from g):\n"
           "    the reason on stderr and exit 1, unless --allow_motion;\n"
           "  - a window beyond the end of the record or with fewer than 8 samples: exit 1.",

@@ -203,6 +203,41 @@ TEST(LevelingBatchTest, StrongSecondHarmonicFindsTheFundamental) {
   EXPECT_NEAR(r.estimate.pitch_rad, truth.pitch_rad, 4.0 * r.estimate.pitch_sigma_rad);  // 4 sigma, fixed seed
 }
 
+TEST(LevelingBatchTest, SaturatedSamplesAreLeftOutOfTheFit) {
+  // A 2 g tone on x through a +-1.9 g accelerometer at 10 deg pitch (x offset +0.17 g): the
+  // positive crests clip, the negative ones do not. The batch fits the unclipped samples;
+  // fitting the clipped ones too biases pitch by the clipped area.
+  sim::Rng rng(23);
+  Truth truth;
+  truth.pitch_rad = 10.0 * kDegToRad;
+  truth.tones = {{0, 1, 2.0 * kG, 0.3}};
+  AccelWindow window = Simulate(truth, rng);
+  LevelingOptions options;
+  options.accel_range_mps2 = 1.9 * kG;
+  options.accel_noise_mps2 = kNoise;
+  int clipped = 0;
+  for (Eigen::Vector3d& f : window.f_b_mps2) {
+    if (std::abs(f.x()) > options.accel_range_mps2) {
+      f.x() = std::copysign(options.accel_range_mps2, f.x());
+      ++clipped;
+    }
+  }
+  ASSERT_GT(clipped, 10) << "the case this test is about";
+  const LevelEstimate kept = SolveLevelingBatch(window, options, EstimateWindowPeriod(window, options)).estimate;
+  const LevelEstimate batch = RunBatch(window, options);
+  // CheckWindow's rule: at or beyond 99.5 % of the range, so samples just below it count too.
+  int removed = 0;
+  WithoutSaturatedSamples(window, options, &removed);
+  EXPECT_GE(removed, clipped);
+  EXPECT_LE(removed, clipped + 3);
+  EXPECT_NE(batch.fallback.find(std::to_string(removed) + " saturated samples left out"), std::string::npos)
+      << batch.fallback;
+  EXPECT_EQ(batch.samples_used, kSamples - removed);
+  // 4 sigma (fixed seed); with the clipped samples in the fit the error is many sigma.
+  EXPECT_NEAR(batch.pitch_rad, truth.pitch_rad, 4.0 * batch.pitch_sigma_rad);
+  EXPECT_GT(std::abs(kept.pitch_rad - truth.pitch_rad), 4.0 * batch.pitch_sigma_rad);
+}
+
 TEST(LevelingBatchTest, NoiseFreeWindowRecoversTheVibrationExactly) {
   Truth truth;
   truth.roll_rad = 3.0 * kDegToRad;
