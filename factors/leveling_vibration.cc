@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/leveling_model.h"
+
 namespace navtwin {
 
 LevelingVibration::LevelingVibration(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& f_meas_b_mps2,
@@ -35,12 +37,10 @@ LevelingVibration::LevelingVibration(const std::vector<double>& t_s, const std::
 
 bool LevelingVibration::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   // Shared by every sample: the at-rest model, its Jacobian and the bias.
-  const double sr = std::sin(parameters[0][0]), cr = std::cos(parameters[0][0]);
-  const double sp = std::sin(parameters[0][1]), cp = std::cos(parameters[0][1]);
-  const Eigen::Vector3d at_rest(g_ * sp, -g_ * sr * cp, -g_ * cr * cp);
+  const Eigen::Vector3d at_rest = leveling::SpecificForceAtRest(parameters[0][0], parameters[0][1], g_);
   // d r / d (roll, pitch), 3 x 2 row-major: rows x, y, z; columns roll, pitch.
-  const double j_attitude[6] = {0.0, g_ * cp * inv_sigma_, -g_ * cr * cp * inv_sigma_, g_ * sr * sp * inv_sigma_,
-                                g_ * sr * cp * inv_sigma_, g_ * cr * sp * inv_sigma_};
+  const Eigen::Matrix<double, 3, 2, Eigen::RowMajor> j_attitude =
+      leveling::SpecificForceAtRestJacobian(parameters[0][0], parameters[0][1], g_) * inv_sigma_;
   const int bias_block = BiasBlock(num_harmonics_);
   const Eigen::Vector3d bias =
       with_bias_ ? Eigen::Vector3d(Eigen::Map<const Eigen::Vector3d>(parameters[bias_block])) : Eigen::Vector3d::Zero();
@@ -76,7 +76,7 @@ bool LevelingVibration::Evaluate(double const* const* parameters, double* residu
         for (int a = 0; a < 3; ++a) jacobians[1][3 * k + a] = two_pi_t_[k] * de_dw[a] * inv_sigma_;
       }
     }
-    if (wanted(0)) std::copy(j_attitude, j_attitude + 6, jacobians[0] + 3 * k * kAttitudeSize);
+    if (wanted(0)) std::copy(j_attitude.data(), j_attitude.data() + 6, jacobians[0] + 3 * k * kAttitudeSize);
     if (with_bias_ && wanted(bias_block)) {
       Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> j(jacobians[bias_block] + 3 * k * kBiasSize);
       j = Eigen::Matrix3d::Identity() * inv_sigma_;

@@ -7,8 +7,9 @@
 //   m = ( g sin(pitch), -g sin(roll) cos(pitch), -g cos(roll) cos(pitch) )   (equation 1)
 //   w_k = 2 pi f t_k
 //
-// m is SpecificForceAtRest of problems/leveling/model.h, written out here because factors
-// do not include problems (the test holds the two equal through an autodiff reference).
+// m and its attitude Jacobian are SpecificForceAtRest and SpecificForceAtRestJacobian of
+// core/leveling_model.h, the model every leveling method shares (the test also holds the
+// whole residual equal to an autodiff reference built on it).
 // One cost function holds one sample (the residual of one sample) or a whole window of N
 // samples (3N residuals, sample k in rows 3k..3k+2): the window form is the same residuals
 // evaluated in one call, which saves the per-block overhead of Ceres and the trigonometry

@@ -17,7 +17,7 @@
 
 #include "factors/leveling_vibration.h"
 #include "factors/state_prior.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {

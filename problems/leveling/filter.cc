@@ -8,7 +8,7 @@
 
 #include <Eigen/LU>
 
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {
@@ -116,16 +116,6 @@ PeriodFit RefinePeriod(const std::vector<Eigen::Vector3d>& x, double p0) {
 
 }  // namespace
 
-Eigen::Matrix<double, 3, 2> SpecificForceJacobian(double roll_rad, double pitch_rad, double g_mps2) {
-  const double sr = std::sin(roll_rad), cr = std::cos(roll_rad);
-  const double sp = std::sin(pitch_rad), cp = std::cos(pitch_rad);
-  Eigen::Matrix<double, 3, 2> h;
-  h << 0.0, g_mps2 * cp,  // f = g (sin p, -sin r cos p, -cos r cos p)
-      -g_mps2 * cr * cp, g_mps2 * sr * sp,  //
-      g_mps2 * sr * cp, g_mps2 * cr * sp;
-  return h;
-}
-
 OnlineLeveler::OnlineLeveler(const LevelingOptions& options, double rate_hz, int max_lag_samples)
     : options_(options), rate_hz_(rate_hz), autocorr_(max_lag_samples) {
   window_.rate_hz = rate_hz;
@@ -224,7 +214,7 @@ void OnlineLeveler::ProcessBlock() {
   // Gravity: the configured value, else the magnitude of the period-averaged specific force
   // (the mean |f| of the samples would count the vibration: +25 % for 1 g across gravity).
   const double g = options_.gravity_mps2 > 0.0 ? options_.gravity_mps2 : block_sum_.norm() / blocks_;
-  const Eigen::Matrix<double, 3, 2> h = SpecificForceJacobian(x_(0), x_(1), g);
+  const Eigen::Matrix<double, 3, 2> h = SpecificForceAtRestJacobian(x_(0), x_(1), g);
   const Eigen::Vector3d innovation = z - SpecificForceAtRest(x_(0), x_(1), g);
   const Eigen::Matrix2d information = p_.inverse() + h.transpose() * h / r;
   p_ = information.inverse();

@@ -55,10 +55,6 @@ class OnlineLeveler {
   Eigen::Matrix2d p_ = Eigen::Matrix2d::Zero();
 };
 
-/// d SpecificForceAtRest / d(roll, pitch) at g_mps2: the filter's measurement Jacobian H
-/// (columns roll, pitch).
-Eigen::Matrix<double, 3, 2> SpecificForceJacobian(double roll_rad, double pitch_rad, double g_mps2);
-
 /// Runs OnlineLeveler over a window (max lag = options.max_lag_fraction of it) and
 /// returns its final estimate.
 LevelEstimate RunFilter(const AccelWindow& window, const LevelingOptions& options);

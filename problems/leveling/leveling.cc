@@ -6,7 +6,7 @@
 
 #include "problems/leveling/batch.h"
 #include "problems/leveling/filter.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {

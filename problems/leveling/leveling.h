@@ -1,6 +1,6 @@
 // Leveling (roll and pitch from accelerometers at rest) under rotor vibration, seed 000:
 // four methods on one window of specific-force samples, all sharing the measurement
-// model of problems/leveling/model.h (equation 1).
+// model of core/leveling_model.h (equation 1).
 //   plain_mean      the mean of all samples (what the seed compares against);
 //   period_average  the seed's method: autocorrelation period, whole-period averages;
 //   filter          an online estimator fed by period-averaged accelerations as samples

@@ -11,7 +11,7 @@
 #include "core/sim/random.h"
 #include "problems/leveling/batch.h"
 #include "problems/leveling/filter.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {

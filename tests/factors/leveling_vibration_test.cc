@@ -1,5 +1,5 @@
 // LevelingVibration: layout of the parameter blocks, the residual against a templated
-// reference built on the shared leveling model (problems/leveling/model.h), and every
+// reference built on the shared leveling model (core/leveling_model.h), and every
 // analytic Jacobian block against autodiff of that reference and against central
 // differences, at zero, at a tiny perturbation and at a random point (fixed seed), for one
 // sample and for a window of samples; the window form is the samples stacked.
@@ -18,7 +18,7 @@
 #include <ceres/dynamic_autodiff_cost_function.h>
 #include <gtest/gtest.h>
 
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "core/rotation.h"
 #include "core/sim/random.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {

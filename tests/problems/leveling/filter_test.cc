@@ -9,7 +9,7 @@
 
 #include "core/rotation.h"
 #include "core/sim/random.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {
@@ -49,7 +49,7 @@ TEST(LevelingFilterTest, MeasurementJacobianMatchesCentralDifferences) {
   sim::Rng rng(31);
   for (int trial = 0; trial < 20; ++trial) {
     const double roll = rng.Uniform(-3.0, 3.0), pitch = rng.Uniform(-1.5, 1.5), g = rng.Uniform(9.0, 10.5);
-    const Eigen::Matrix<double, 3, 2> h = SpecificForceJacobian(roll, pitch, g);
+    const Eigen::Matrix<double, 3, 2> h = SpecificForceAtRestJacobian(roll, pitch, g);
     const double step = 1e-6;
     const Eigen::Vector3d d_roll =
         (SpecificForceAtRest(roll + step, pitch, g) - SpecificForceAtRest(roll - step, pitch, g)) / (2 * step);

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {

@@ -15,7 +15,7 @@
 #include "core/io/input_error.h"
 #include "core/sim/random.h"
 #include "problems/leveling/leveling.h"
-#include "problems/leveling/model.h"
+#include "core/leveling_model.h"
 
 namespace navtwin::leveling {
 namespace {

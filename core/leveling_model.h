@@ -1,4 +1,8 @@
-// The leveling measurement model shared by every leveling method (equation 1 of seed 000).
+// The leveling measurement model shared by every leveling method (equation 1 of seed 000):
+// the plain mean and period average (problems/leveling/leveling.cc), the online filter
+// (problems/leveling/filter.cc) and the Ceres residual of the batch
+// (factors/leveling_vibration.*). In core because it is plain math used by factors and
+// problems alike.
 // At rest the accelerometers sense f_b = R_b_n (0, 0, -g)^T in body FRD axes, NED frame:
 //   f_b = ( g sin(pitch), -g sin(roll) cos(pitch), -g cos(roll) cos(pitch) )
 // and inversely (the signed atan2 form of equation 1)
@@ -19,6 +23,18 @@ Eigen::Matrix<T, 3, 1> SpecificForceAtRest(const T& roll_rad, const T& pitch_rad
   const T cp = cos(pitch_rad);
   return Eigen::Matrix<T, 3, 1>(g_mps2 * sin(pitch_rad), -g_mps2 * sin(roll_rad) * cp,
                                 -g_mps2 * cos(roll_rad) * cp);
+}
+
+/// d SpecificForceAtRest / d(roll, pitch) (3 x 2, columns roll, pitch): the filter's
+/// measurement Jacobian and the attitude block of the batch residual.
+inline Eigen::Matrix<double, 3, 2> SpecificForceAtRestJacobian(double roll_rad, double pitch_rad, double g_mps2) {
+  const double sr = std::sin(roll_rad), cr = std::cos(roll_rad);
+  const double sp = std::sin(pitch_rad), cp = std::cos(pitch_rad);
+  Eigen::Matrix<double, 3, 2> j;
+  j << 0.0, g_mps2 * cp,  //
+      -g_mps2 * cr * cp, g_mps2 * sr * sp,  //
+      g_mps2 * sr * cp, g_mps2 * cr * sp;
+  return j;
 }
 
 /// Roll and pitch (rad) from a mean specific force (equation 1, atan2 form).
