@@ -2,7 +2,7 @@
 // windows of a level, resting accelerometer triad disturbed by rotor vibration and white
 // noise, each levelled by all four methods (plain_mean, period_average, filter, batch);
 // per method the RMS and largest roll and pitch errors. `navtwin level-mc` runs it;
-// docs/leveling.md gives the figures.
+// docs/leveling-results.md gives the figures.
 //
 // One run: the fundamental f ~ U[lo, hi]; on every vibrating axis and for every harmonic
 // h = 1..tones an amplitude A ~ N(0, (vib_amp_g g / h)^2) (harmonic gain 1/h, the
