@@ -54,13 +54,13 @@ TEST(LevelingModelTest, LevelJacobianMatchesCentralDifferences) {
 TEST(LevelingModelTest, SpecificForceJacobianMatchesCentralDifferences) {
   sim::Rng rng(5);
   for (int trial = 0; trial < 20; ++trial) {
-    const double roll = rng.Uniform(-3.0, 3.0), pitch = rng.Uniform(-1.5, 1.5);
-    const Eigen::Matrix<double, 3, 2> j = SpecificForceAtRestJacobian(roll, pitch, kG);
+    const double roll = rng.Uniform(-3.0, 3.0), pitch = rng.Uniform(-1.5, 1.5), g = rng.Uniform(9.0, 10.5);
+    const Eigen::Matrix<double, 3, 2> j = SpecificForceAtRestJacobian(roll, pitch, g);
     const double h = 1e-6;
     const Eigen::Vector3d d_roll =
-        (SpecificForceAtRest(roll + h, pitch, kG) - SpecificForceAtRest(roll - h, pitch, kG)) / (2 * h);
+        (SpecificForceAtRest(roll + h, pitch, g) - SpecificForceAtRest(roll - h, pitch, g)) / (2 * h);
     const Eigen::Vector3d d_pitch =
-        (SpecificForceAtRest(roll, pitch + h, kG) - SpecificForceAtRest(roll, pitch - h, kG)) / (2 * h);
+        (SpecificForceAtRest(roll, pitch + h, g) - SpecificForceAtRest(roll, pitch - h, g)) / (2 * h);
     // Central differences at h = 1e-6 rad of a function of size g: error ~1e-9 m/s^2.
     EXPECT_NEAR((j.col(0) - d_roll).norm(), 0.0, 1e-7);
     EXPECT_NEAR((j.col(1) - d_pitch).norm(), 0.0, 1e-7);

@@ -15,52 +15,12 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/leveling_model.h"
+#include "tests/problems/leveling/simulated_window.h"
 
 namespace navtwin::leveling {
 namespace {
 
-constexpr double kG = kStandardGravity_mps2;
-constexpr double kPi = 3.141592653589793;
-constexpr double kNoise = 0.05 * kG;  // 50 mg
-constexpr int kSamples = 120;
-constexpr double kRate = 600.0;
-
-// amplitude sin(2 pi harmonic f (t - t_centre) + phase): the phase at the window centre,
-// the batch's time reference.
-struct Tone {
-  int axis;
-  int harmonic;
-  double amplitude_mps2;
-  double phase_rad;
-};
-
-struct Truth {
-  double roll_rad = 0.0;
-  double pitch_rad = 0.0;
-  double f_hz = 23.3;
-  std::vector<Tone> tones;
-  Eigen::Vector3d bias_mps2 = Eigen::Vector3d::Zero();
-  double noise_mps2 = kNoise;
-  double t0_s = 0.0;
-};
-
-AccelWindow Simulate(const Truth& truth, sim::Rng& rng) {
-  AccelWindow w;
-  w.rate_hz = kRate;
-  w.source = "simulation";
-  const double t_centre = truth.t0_s + 0.5 * (kSamples - 1) / kRate;
-  const Eigen::Vector3d at_rest = SpecificForceAtRest(truth.roll_rad, truth.pitch_rad, kG) + truth.bias_mps2;
-  for (int k = 0; k < kSamples; ++k) {
-    const double t = truth.t0_s + k / kRate;
-    Eigen::Vector3d f = at_rest + rng.Normal3(truth.noise_mps2);
-    for (const Tone& tone : truth.tones) {
-      f[tone.axis] += tone.amplitude_mps2 * std::sin(2.0 * kPi * tone.harmonic * truth.f_hz * (t - t_centre) + tone.phase_rad);
-    }
-    w.t_s.push_back(t);
-    w.f_b_mps2.push_back(f);
-  }
-  return w;
-}
+using namespace test_windows;
 
 // The seed's vibration: body x, 1 g, random phase.
 Truth SeedTruth(sim::Rng& rng, double roll_deg = 0.0, double pitch_deg = 0.0) {

@@ -10,6 +10,8 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/leveling_model.h"
+#include "problems/leveling/monte_carlo.h"
+#include "tests/problems/leveling/simulated_window.h"
 
 namespace navtwin::leveling {
 namespace {
@@ -19,46 +21,17 @@ constexpr double kPi = 3.141592653589793;
 constexpr double kRate_hz = 600.0;
 constexpr int kSamples = 120;  // 0.2 s at 600 Hz: the seed's window
 
-// One window of the seed's experiment at a given truth: body-x vibration
-// amplitude_mps2 sin(2 pi f t + phase) plus white noise on every axis.
-AccelWindow SimulateWindow(double roll_rad, double pitch_rad, double freq_hz, double amplitude_mps2,
-                           double phase_rad, double noise_mps2, sim::Rng* rng) {
-  AccelWindow w;
-  w.rate_hz = kRate_hz;
-  w.source = "simulation";
-  const Eigen::Vector3d f0 = SpecificForceAtRest(roll_rad, pitch_rad, kG);
-  for (int k = 0; k < kSamples; ++k) {
-    const double t = k / kRate_hz;
-    Eigen::Vector3d f = f0 + rng->Normal3(noise_mps2);
-    f.x() += amplitude_mps2 * std::sin(2.0 * kPi * freq_hz * t + phase_rad);
-    w.t_s.push_back(t);
-    w.f_b_mps2.push_back(f);
-  }
-  return w;
-}
-
-// The seed's draws: frequency U[22, 24] Hz, amplitude N(0, 1 g), phase U[0, 2 pi), 50 mg.
-AccelWindow SeedWindow(double roll_rad, double pitch_rad, sim::Rng* rng) {
-  const double freq_hz = rng->Uniform(22.0, 24.0);
-  const double amplitude = rng->Normal(kG);
-  const double phase = rng->Uniform(0.0, 2.0 * kPi);
-  return SimulateWindow(roll_rad, pitch_rad, freq_hz, amplitude, phase, 0.05 * kG, rng);
-}
-
-TEST(LevelingFilterTest, MeasurementJacobianMatchesCentralDifferences) {
-  sim::Rng rng(31);
-  for (int trial = 0; trial < 20; ++trial) {
-    const double roll = rng.Uniform(-3.0, 3.0), pitch = rng.Uniform(-1.5, 1.5), g = rng.Uniform(9.0, 10.5);
-    const Eigen::Matrix<double, 3, 2> h = SpecificForceAtRestJacobian(roll, pitch, g);
-    const double step = 1e-6;
-    const Eigen::Vector3d d_roll =
-        (SpecificForceAtRest(roll + step, pitch, g) - SpecificForceAtRest(roll - step, pitch, g)) / (2 * step);
-    const Eigen::Vector3d d_pitch =
-        (SpecificForceAtRest(roll, pitch + step, g) - SpecificForceAtRest(roll, pitch - step, g)) / (2 * step);
-    // Truncation ~ g step^2 / 6 ~ 2e-12, rounding ~ g 1e-16 / step ~ 1e-9 m/s^2 per rad.
-    EXPECT_NEAR((h.col(0) - d_roll).norm(), 0.0, 1e-7) << "roll " << roll << " pitch " << pitch;
-    EXPECT_NEAR((h.col(1) - d_pitch).norm(), 0.0, 1e-7) << "roll " << roll << " pitch " << pitch;
-  }
+// One window with a body-x tone amplitude_mps2 sin(2 pi f (t - t_centre) + phase) plus
+// white noise on every axis.
+AccelWindow OneTone(double roll_rad, double pitch_rad, double freq_hz, double amplitude_mps2, double phase_rad,
+                    double noise_mps2, sim::Rng* rng) {
+  test_windows::Truth truth;
+  truth.roll_rad = roll_rad;
+  truth.pitch_rad = pitch_rad;
+  truth.f_hz = freq_hz;
+  truth.tones = {{0, 1, amplitude_mps2, phase_rad}};
+  truth.noise_mps2 = noise_mps2;
+  return test_windows::Simulate(truth, *rng);
 }
 
 TEST(LevelingFilterTest, NoiseFreeSinusoidLevelsWithinTwoHundredthsOfADegree) {
@@ -68,7 +41,7 @@ TEST(LevelingFilterTest, NoiseFreeSinusoidLevelsWithinTwoHundredthsOfADegree) {
   options.accel_noise_mps2 = 0.01;  // the noise the filter assumes (estimated, it would be ~0)
   for (const double freq_hz : {22.0, 22.6, 23.3, 24.0}) {
     for (const double phase : {0.4, 2.9, 5.1}) {
-      const AccelWindow w = SimulateWindow(roll, pitch, freq_hz, kG, phase, 0.0, &rng);
+      const AccelWindow w = OneTone(roll, pitch, freq_hz, kG, phase, 0.0, &rng);
       const LevelEstimate e = RunFilter(w, options);
       ASSERT_TRUE(e.fallback.empty()) << e.fallback;
       EXPECT_EQ(e.method, "filter");
@@ -116,10 +89,13 @@ struct MonteCarloResult {
 
 MonteCarloResult RunSeedExperiment(int runs, double roll, double pitch, const LevelingOptions& options,
                                    std::uint64_t seed) {
-  sim::Rng rng(seed);
+  MonteCarloConfig config;  // the seed's draws (problems/leveling/monte_carlo.h)
+  config.true_roll_deg = roll * kRadToDeg;
+  config.true_pitch_deg = pitch * kRadToDeg;
+  config.seed = seed;
   MonteCarloResult m;
   for (int i = 0; i < runs; ++i) {
-    const LevelEstimate e = RunFilter(SeedWindow(roll, pitch, &rng), options);
+    const LevelEstimate e = RunFilter(SimulateWindow(config, i), options);
     m.pitch_rms_deg += std::pow((e.pitch_rad - pitch) * kRadToDeg, 2) / runs;
     m.roll_rms_deg += std::pow((e.roll_rad - roll) * kRadToDeg, 2) / runs;
     m.pitch_sigma_deg += e.pitch_sigma_rad * kRadToDeg / runs;
@@ -162,7 +138,7 @@ TEST(LevelingFilterTest, SeedExperimentTiltedTruthEstimatedNoise) {
 TEST(LevelingFilterTest, CovarianceShrinksAsBlocksArrive) {
   sim::Rng rng(12);
   const double sigma = 0.05 * kG;
-  const AccelWindow w = SimulateWindow(0.02, -0.03, 23.0, kG, 1.0, sigma, &rng);
+  const AccelWindow w = OneTone(0.02, -0.03, 23.0, kG, 1.0, sigma, &rng);
   LevelingOptions options;
   options.accel_noise_mps2 = sigma;
   OnlineLeveler filter(options, kRate_hz, kSamples / 2);

@@ -9,6 +9,7 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/leveling_model.h"
+#include "problems/leveling/monte_carlo.h"
 
 namespace navtwin::leveling {
 namespace {
@@ -16,34 +17,14 @@ namespace {
 constexpr double kG = kStandardGravity_mps2;
 constexpr double kPi = 3.141592653589793;
 
-// The seed's experiment for one run: 600 Hz, 120 samples, body-x vibration of
-// frequency U[22, 24] Hz, amplitude N(0, 1 g), phase U[0, 2 pi), 50 mg white noise.
-AccelWindow SeedWindow(sim::Rng& rng, double roll_rad = 0.0, double pitch_rad = 0.0,
-                       double noise_mps2 = 0.05 * kG) {
-  const double f_hz = rng.Uniform(22.0, 24.0);
-  const double amplitude = rng.Normal(kG);
-  const double phase = rng.Uniform(0.0, 2.0 * kPi);
-  AccelWindow w;
-  w.rate_hz = 600.0;
-  w.source = "simulation";
-  const Eigen::Vector3d f0 = SpecificForceAtRest(roll_rad, pitch_rad, kG);
-  for (int k = 0; k < 120; ++k) {
-    const double t = k / 600.0;
-    Eigen::Vector3d f = f0 + rng.Normal3(noise_mps2);
-    f.x() += amplitude * std::sin(2.0 * kPi * f_hz * t + phase);
-    w.t_s.push_back(t);
-    w.f_b_mps2.push_back(f);
-  }
-  return w;
-}
-
 TEST(LevelingTest, NoiseEstimateIgnoresTheVibration) {
-  sim::Rng rng(4);
+  MonteCarloConfig seed_experiment;  // the seed's draws (problems/leveling/monte_carlo.h)
+  seed_experiment.seed = 4;
   double sum2 = 0.0;
   const int windows = 50;
   LevelingOptions options;
   for (int i = 0; i < windows; ++i) {
-    const AccelWindow w = SeedWindow(rng);
+    const AccelWindow w = SimulateWindow(seed_experiment, i);
     const signal::PeriodEstimate p = EstimateWindowPeriod(w, options);
     const double sigma = EstimateAccelNoise(w, p.found ? p.refined_period_samples : 0.0);
     sum2 += sigma * sigma;
@@ -75,14 +56,15 @@ TEST(LevelingTest, NoiseFreeWholePeriodsLevelExactly) {
 }
 
 TEST(LevelingTest, SeedExperimentPlainMeanAndPeriodAverage) {
-  sim::Rng rng(2021);
+  MonteCarloConfig seed_experiment;
+  seed_experiment.seed = 2021;
   LevelingOptions options;
   options.accel_noise_mps2 = 0.05 * kG;
   const int runs = 1000;
   double plain2 = 0.0, period2 = 0.0, sigma2 = 0.0;
   int fallbacks = 0;
   for (int i = 0; i < runs; ++i) {
-    const AccelWindow w = SeedWindow(rng);
+    const AccelWindow w = SimulateWindow(seed_experiment, i);
     const LevelEstimate a = PlainMean(w, options);
     const LevelEstimate b = PeriodAverage(w, options);
     plain2 += a.pitch_rad * a.pitch_rad;
