@@ -62,19 +62,25 @@ init_errors: {velocity_ned_mps: [0.5, -0.5, 0.2], attitude_deg: [0.5, -0.5, 1.0]
 // table: gyro bias 0.01 deg/h, random walk 0.005 deg/sqrt(h), accelerometer bias 100 ug,
 // scale factors 100 ppm, misalignments 5 arcsec; biases fixed so that the east gyro bias
 // sets the seed's ~3 arcmin Kalman-only plateau), GPS 17 m (1 sigma) at 1 Hz, a
-// barometer for the vertical channel; a few seconds of vertical acceleration (a pull-up)
-// and acceleration to Mach 0.7 (238 m/s), then south. Initial heading error 20 arcmin;
-// level errors at the accelerometer-bias limit (100 ug = 0.34 arcmin).
+// barometer for the vertical channel. The seed's INS is aligned at rest (levels on the
+// accelerometers, heading input from outside) and launched: here 5 s at rest, a launch
+// acceleration to 100 m/s, a few seconds of vertical acceleration (a pull-up to 40 m/s
+// vertical speed), acceleration to Mach 0.7 (238 m/s), then south. Starting at rest
+// matters: a heading error rotates only the velocity the INS gains after its velocity
+// was set, so the seed's "17 m / 10 km" needs the whole distance to be gained.
+// Initial heading error 20 arcmin; level errors at the accelerometer-bias limit
+// (100 ug = 0.34 arcmin).
 constexpr const char* kInflight = R"(name: inflight-mach07-south
-description: seed 003 - 1 NM/h INS, GPS 17 m, pull-up then Mach 0.7 south, 20 arcmin initial heading error
+description: seed 003 - 1 NM/h INS, GPS 17 m, launch from rest, pull-up, Mach 0.7 south, 20 arcmin initial heading error
 start: {lat_deg: 36.5, lon_deg: 127.0, h_m: 1000}
 trajectory:
-  initial: {speed_mps: 100, heading_deg: 180}
+  initial: {speed_mps: 0, heading_deg: 180}
   segments:
-    - {kind: cruise, duration_s: 10}
+    - {kind: static, duration_s: 5}
+    - {kind: accelerate, duration_s: 8, speed_mps: 100}
     - {kind: climb, duration_s: 5, vertical_speed_mps: 40, transition_s: 2}
-    - {kind: accelerate, duration_s: 20, speed_mps: 238}
-    - {kind: cruise, duration_s: 510, level: true}
+    - {kind: accelerate, duration_s: 12, speed_mps: 238}
+    - {kind: cruise, duration_s: 515, level: true}
 imu:
   rate_hz: 100
   errors:

@@ -150,10 +150,14 @@ struct Design {
 
 Design BuildDesign(const std::vector<DistanceErrorSample>& samples,
                    const std::array<bool, kSchulerTerms>& terms, const SeparationOptions& options) {
+  // Prior sigma of term k on the north (axis 0) and east (axis 1) axis.
+  const auto prior = [&options](int k, int axis) {
+    return axis == 0 && options.prior_sigma_north[k] > 0.0 ? options.prior_sigma_north[k] : options.prior_sigma[k];
+  };
   int cols = 1, prior_rows = 0;
   for (int k = 0; k < kSchulerTerms; ++k) {
     cols += terms[k] ? 2 : 0;
-    prior_rows += terms[k] && options.prior_sigma[k] > 0.0 ? 2 : 0;
+    for (int axis = 0; axis < 2; ++axis) prior_rows += terms[k] && prior(k, axis) > 0.0 ? 1 : 0;
   }
   const Eigen::Index data_rows = 2 * static_cast<Eigen::Index>(samples.size());
   Design d;
@@ -179,10 +183,8 @@ Design BuildDesign(const std::vector<DistanceErrorSample>& samples,
   int c = 1;
   for (int k = 0; k < kSchulerTerms; ++k) {
     if (!terms[k]) continue;
-    if (options.prior_sigma[k] > 0.0) {
-      const double weight = options.position_sigma_m / options.prior_sigma[k];
-      d.a(row++, c) = weight;
-      d.a(row++, c + 1) = weight;
+    for (int axis = 0; axis < 2; ++axis) {
+      if (prior(k, axis) > 0.0) d.a(row++, c + axis) = options.position_sigma_m / prior(k, axis);
     }
     c += 2;
   }
@@ -207,7 +209,10 @@ void CheckSamples(const std::vector<DistanceErrorSample>& samples, const Separat
   if (!(options.schuler_rate_rad_s > 0.0) || !std::isfinite(options.schuler_rate_rad_s)) {
     throw std::invalid_argument("SeparateHeadingError: the Schuler rate must be positive");
   }
-  for (const double p : options.prior_sigma) {
+  std::array<double, 2 * kSchulerTerms> priors{};
+  std::copy(options.prior_sigma.begin(), options.prior_sigma.end(), priors.begin());
+  std::copy(options.prior_sigma_north.begin(), options.prior_sigma_north.end(), priors.begin() + kSchulerTerms);
+  for (const double p : priors) {
     if (!std::isfinite(p) || p < 0.0) {
       throw std::invalid_argument("SeparateHeadingError: prior sigmas must be finite and >= 0");
     }

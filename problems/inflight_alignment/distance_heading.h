@@ -164,6 +164,11 @@ struct SeparationOptions {
   /// why a condition number cannot tell a short flight from a long one). Needs
   /// position_sigma_m > 0.
   std::array<double, kSchulerTerms> prior_sigma{};
+  /// Where > 0, the prior sigma of a term on the NORTH axis instead of prior_sigma (the
+  /// east axis keeps prior_sigma). E.g. the Earth-rate coupling of the heading error,
+  /// Omega cos L dH, acts like an east gyro bias, so it widens only the north axis's gyro
+  /// term: g sqrt(dw^2 + (Omega cos L sigma_dH0)^2) north, g dw east.
+  std::array<double, kSchulerTerms> prior_sigma_north{};
   /// Largest condition number of the column-scaled design matrix accepted; above it
   /// terms are dropped in the order velocity, offset, gyro, tilt, until it is met.
   double max_condition = 1e6;

@@ -11,7 +11,7 @@
 
 #include "solvers/eskf.h"
 
-namespace navtwin::inflight_alignment {
+namespace navtwin::inflight {
 namespace {
 
 constexpr int kQuiet = 0;
@@ -350,4 +350,4 @@ SmoothedFix GpsSmoother::Output(double t_s, const Eigen::Vector3d& measurement_s
   return out;
 }
 
-}  // namespace navtwin::inflight_alignment
+}  // namespace navtwin::inflight

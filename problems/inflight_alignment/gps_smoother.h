@@ -51,7 +51,7 @@
 #include "core/earth.h"
 #include "core/types.h"
 
-namespace navtwin::inflight_alignment {
+namespace navtwin::inflight {
 
 struct GpsSmootherOptions {
   /// Quiet mode (straight flight): white acceleration noise per axis, as the square root
@@ -155,4 +155,4 @@ class GpsSmoother {
   int rejection_run_ = 0;
 };
 
-}  // namespace navtwin::inflight_alignment
+}  // namespace navtwin::inflight

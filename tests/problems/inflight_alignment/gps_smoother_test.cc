@@ -12,9 +12,10 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/sim/scenario.h"
+#include "core/sim/yaml_config.h"
 #include "core/sim/truth.h"
 
-namespace navtwin::inflight_alignment {
+namespace navtwin::inflight {
 namespace {
 
 constexpr double kGpsSigma_m = 17.0;  // the seed's GPS position error (1 sigma)
@@ -229,11 +230,24 @@ TEST(GpsSmoother, HeldJumpResetsAfterTheConfiguredRun) {
   }
 }
 
-// The seed's pull-up: the preset inflight-mach07-south (10 s cruise at 100 m/s, 5 s climb
-// to 40 m/s vertical with 2 s transitions, 20 s acceleration to 238 m/s on the climb path,
-// level-off in 2 s). Truth at 1 Hz from the simulator's truth generator at 10 Hz.
+// A pull-up in flight (the first form of the preset inflight-mach07-south, which now
+// starts at rest): 10 s cruise at 100 m/s, 5 s climb to 40 m/s vertical with 2 s
+// transitions, 20 s acceleration to 238 m/s on the climb path, level-off in 2 s. Truth at
+// 1 Hz from the simulator's truth generator at 10 Hz.
+constexpr const char* kPullUpScenario = R"(name: pull-up
+start: {lat_deg: 36.5, lon_deg: 127.0, h_m: 1000}
+trajectory:
+  initial: {speed_mps: 100, heading_deg: 180}
+  segments:
+    - {kind: cruise, duration_s: 10}
+    - {kind: climb, duration_s: 5, vertical_speed_mps: 40, transition_s: 2}
+    - {kind: accelerate, duration_s: 20, speed_mps: 238}
+    - {kind: cruise, duration_s: 100, level: true}
+imu: {rate_hz: 100}
+)";
+
 std::vector<Eigen::Vector3d> PullUpTruth(int seconds) {
-  const sim::Scenario sc = sim::LoadScenario("inflight-mach07-south");
+  const sim::Scenario sc = sim::ParseScenario(sim::ParseYaml(kPullUpScenario, "pull-up test scenario"));
   EXPECT_NEAR(sc.start.lat_rad, kOrigin.lat_rad, 1e-12);
   sim::TruthGenerator gen(*sc.trajectory, sc.start, 10.0);
   std::vector<Eigen::Vector3d> truth;
@@ -353,4 +367,4 @@ TEST(GpsSmoother, BadOptionsAreRejected) {
 }
 
 }  // namespace
-}  // namespace navtwin::inflight_alignment
+}  // namespace navtwin::inflight
