@@ -16,12 +16,17 @@
 DEFINE_string(format, "text", "Output format of printed results: text or json");
 
 namespace navtwin::app {
+
+// cmd_inflight.cc (declared here rather than in command.h, which another change owns).
+Command InflightAlignCommand();
+Command InflightMcCommand();
+
 namespace {
 
 std::vector<Command> AllCommands() {
   return {InfoCommand(),     ConvertCommand(),  InsCommand(),   SimulateCommand(),
           AllanCommand(),    NavigateCommand(), SmoothCommand(),  LevelCommand(),
-          LevelMcCommand()};
+          LevelMcCommand(),  InflightAlignCommand(), InflightMcCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {
