@@ -72,7 +72,7 @@ BaroLoopOptions ParseBaro(const ConfigNode& n) {
 /// The smoother's options, with the ranges GpsSmoother checks (gps_smoother.cc), here with
 /// the file and line.
 GpsSmootherOptions ParseSmoother(const ConfigNode& n) {
-  n.RequireKeys({"quiet_accel_noise_mps2_sqrt_hz", "maneuver_accel_noise_mps2_sqrt_hz",
+  n.RequireKeys({"use_in_distance", "use_in_kalman", "quiet_accel_noise_mps2_sqrt_hz", "maneuver_accel_noise_mps2_sqrt_hz",
                  "maneuver_mean_interval_s", "maneuver_mean_duration_s", "initial_position_sigma_ned_m",
                  "initial_speed_sigma_mps", "noise_window_fixes", "noise_min_fixes", "min_position_sigma_m",
                  "max_position_sigma_m", "gate_probability", "reset_after_rejections"});
@@ -151,6 +151,8 @@ InflightConfig ParseRoot(const ConfigNode& root) {
   c.initial = ParseInitial(root.Child("initial"));
   c.baro = ParseBaro(root.Child("baro"));
   c.smoother = ParseSmoother(root.Child("smoother"));
+  c.smooth_gps_distance = root.Child("smoother").Bool("use_in_distance", c.smooth_gps_distance);
+  c.smooth_gps_kalman = root.Child("smoother").Bool("use_in_kalman", c.smooth_gps_kalman);
   c.distance = ParseDistance(root.Child("distance"));
   c.batch = ParseBatch(root.Child("batch"));
   return c;

@@ -168,7 +168,16 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
   }
   P(fstate::kHeading, fstate::kHeading) = heading_rad * heading_rad;
 
+  const bool smooth_gps = distance ? config.smooth_gps_distance : config.smooth_gps_kalman;
   GpsSmoother smoother(config.smoother);
+  // Raw fixes (smooth_gps false): their sigma and the chi-square gate on the 2-dof
+  // innovation, whose quantile is -2 ln(1 - p).
+  const double raw_sigma_m = smooth_gps ? 0.0
+                             : config.sensors.gps_sigma_m > 0.0 ? config.sensors.gps_sigma_m
+                                                                : EstimateGpsSigma(inputs.gnss);
+  const double raw_gate_nis = config.smoother.gate_probability >= 1.0
+                                  ? std::numeric_limits<double>::infinity()
+                                  : -2.0 * std::log(1.0 - config.smoother.gate_probability);
 
   // ---- distance method: the free INS alongside and its samples at accepted fixes
   std::optional<FreeInsTrack> free_ins;
@@ -259,32 +268,42 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
 
     FilterEpoch epoch;
     epoch.t_s = fix.t_s;
-    const SmoothedFix smoothed = smoother.Update(fix);
-    if (smoothed.rejected) {
-      ++run.gps_rejected;
-    } else {
-      // Measurement: smoothed GPS minus INS position moved back to the fix time, NED
-      // metres in the error-state convention (true minus estimate):
-      //   z = [(lat_gps - lat_ins)(M + h), (lon_gps - lon_ins)(N + h) cos lat] = dp_NE + v.
-      const NavState& nav = strapdown.state();
-      const double dt_back_s = nav.t_s - fix.t_s;
-      const double rm = wgs84::MeridianRadius(nav.lat_rad) + nav.h_m;
-      const double rn = wgs84::PrimeVerticalRadius(nav.lat_rad) + nav.h_m;
-      const double lat_ins = nav.lat_rad - nav.v_n_mps.x() * dt_back_s / rm;
-      const double lon_ins = nav.lon_rad - nav.v_n_mps.y() * dt_back_s / (rn * std::cos(nav.lat_rad));
-      const Eigen::Vector2d z((smoothed.lat_rad - lat_ins) * rm,
-                              WrapPi(smoothed.lon_rad - lon_ins) * rn * std::cos(nav.lat_rad));
+    // The GPS position of the fix and its sigma: smoothed (the seed) or raw.
+    wgs84::Geodetic gps{fix.lat_rad, fix.lon_rad, fix.h_m};
+    Eigen::Vector2d r_sigma_m = Eigen::Vector2d::Constant(raw_sigma_m);
+    bool accepted = true;
+    if (smooth_gps) {
+      const SmoothedFix smoothed = smoother.Update(fix);
+      accepted = !smoothed.rejected;
+      gps = wgs84::Geodetic{smoothed.lat_rad, smoothed.lon_rad, smoothed.h_m};
       // R: the smoother's RAW-measurement sigma, not the smoothed fix's own (smaller)
       // sigma. Consecutive smoothed fixes share most of their raw data, so their errors
       // are strongly correlated in time; a white-noise update with the smoothed sigma would
       // count the same raw fix many times over and make the filter overconfident. With the
       // raw sigma the sequence of updates carries about the information of the raw fixes,
       // while the smoother's role is to remove the outliers and jumps.
-      const Eigen::Vector2d r_sigma_m = smoothed.measurement_sigma_ned_m.head<2>();
-      const Eigen::Matrix2d R = r_sigma_m.cwiseAbs2().asDiagonal();
-      // H = [I2 0]: P H^T is P's first two columns.
-      const Eigen::Matrix2d S = P.topLeftCorner<2, 2>() + R;
-      Gain K = P.leftCols<2>() * S.inverse();
+      r_sigma_m = smoothed.measurement_sigma_ned_m.head<2>();
+    }
+    // Measurement: GPS minus INS position moved back to the fix time, NED metres in the
+    // error-state convention (true minus estimate):
+    //   z = [(lat_gps - lat_ins)(M + h), (lon_gps - lon_ins)(N + h) cos lat] = dp_NE + v.
+    const NavState& nav = strapdown.state();
+    const double dt_back_s = nav.t_s - fix.t_s;
+    const double rm = wgs84::MeridianRadius(nav.lat_rad) + nav.h_m;
+    const double rn = wgs84::PrimeVerticalRadius(nav.lat_rad) + nav.h_m;
+    const double lat_ins = nav.lat_rad - nav.v_n_mps.x() * dt_back_s / rm;
+    const double lon_ins = nav.lon_rad - nav.v_n_mps.y() * dt_back_s / (rn * std::cos(nav.lat_rad));
+    const Eigen::Vector2d z((gps.lat_rad - lat_ins) * rm, WrapPi(gps.lon_rad - lon_ins) * rn * std::cos(nav.lat_rad));
+    const Eigen::Matrix2d R = r_sigma_m.cwiseAbs2().asDiagonal();
+    // H = [I2 0]: P H^T is P's first two columns.
+    const Eigen::Matrix2d S = P.topLeftCorner<2, 2>() + R;
+    const Eigen::Matrix2d S_inv = S.inverse();
+    // Raw fixes: the filter's own gate (the smoother has gated smoothed ones).
+    if (accepted && !smooth_gps) accepted = z.dot(S_inv * z) <= raw_gate_nis;
+    if (!accepted) {
+      ++run.gps_rejected;
+    } else {
+      Gain K = P.leftCols<2>() * S_inv;
       // Distance method: phi_D is a consider state (Schmidt-Kalman); its gain row is zero,
       // so the heading estimate never moves, while its variance and correlations still
       // shape the other gains. The Joseph form below keeps P right for any gain.
@@ -302,8 +321,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
       epoch.gps_used = true;
 
       if (distance) {
-        samples.push_back(free_ins->SampleAt(
-            fix.t_s, wgs84::Geodetic{smoothed.lat_rad, smoothed.lon_rad, smoothed.h_m}));
+        samples.push_back(free_ins->SampleAt(fix.t_s, gps));
         if (path_length_m >= next_computation_m) {
           // Heading computation (equation 8 with the Schuler part removed) over every
           // sample since the start. A fit that cannot be made yet (no displacement gained:

@@ -84,7 +84,9 @@ MethodResult RunFilterMethod(const InflightInputs& inputs, const InflightConfig&
   r.computations = run.computations;
 
   std::ostringstream note;
-  note << run.gps_rejected << " of " << run.epochs.size() << " GPS fixes rejected by the smoother's gate";
+  const bool smoothed = method == Method::kDistance ? config.smooth_gps_distance : config.smooth_gps_kalman;
+  note << run.gps_rejected << " of " << run.epochs.size() << " GPS fixes rejected by "
+       << (smoothed ? "the smoother's gate (smoothed fixes)" : "the filter's gate (raw fixes)");
   if (method == Method::kDistance) {
     note << "; " << run.computations.size() << " heading computation" << (run.computations.size() == 1 ? "" : "s");
     if (!run.computations.empty() && !run.computations.back().separation.note.empty()) {

@@ -28,6 +28,8 @@ initial:
 baro:
   time_constant_s: 30
 smoother:
+  use_in_distance: false
+  use_in_kalman: true
   quiet_accel_noise_mps2_sqrt_hz: 0.2
   maneuver_accel_noise_mps2_sqrt_hz: 20
   maneuver_mean_interval_s: 5000
@@ -62,6 +64,9 @@ TEST(InflightConfigTest, EveryKeyIsRead) {
   EXPECT_EQ(c.initial.level_arcmin, 0.5);
   EXPECT_EQ(c.initial.heading_arcmin, 60.0);
   EXPECT_EQ(c.baro.time_constant_s, 30.0);
+  // Both opposite to the defaults (distance smooths, kalman does not).
+  EXPECT_FALSE(c.smooth_gps_distance);
+  EXPECT_TRUE(c.smooth_gps_kalman);
   const GpsSmootherOptions& s = c.smoother;
   EXPECT_EQ(s.quiet_accel_noise_mps2_sqrt_hz, 0.2);
   EXPECT_EQ(s.maneuver_accel_noise_mps2_sqrt_hz, 20.0);
@@ -109,6 +114,8 @@ TEST(InflightConfigTest, ShippedPresetFileHoldsTheDefaultsAndTheGpsSigma) {
   EXPECT_EQ(c.initial.level_arcmin, d.initial.level_arcmin);
   EXPECT_EQ(c.initial.heading_arcmin, d.initial.heading_arcmin);
   EXPECT_EQ(c.baro.time_constant_s, d.baro.time_constant_s);
+  EXPECT_EQ(c.smooth_gps_distance, d.smooth_gps_distance);
+  EXPECT_EQ(c.smooth_gps_kalman, d.smooth_gps_kalman);
   EXPECT_EQ(c.smoother.quiet_accel_noise_mps2_sqrt_hz, d.smoother.quiet_accel_noise_mps2_sqrt_hz);
   EXPECT_EQ(c.smoother.maneuver_accel_noise_mps2_sqrt_hz, d.smoother.maneuver_accel_noise_mps2_sqrt_hz);
   EXPECT_EQ(c.smoother.maneuver_mean_interval_s, d.smoother.maneuver_mean_interval_s);
