@@ -20,13 +20,16 @@ namespace navtwin::app {
 // cmd_inflight.cc (declared here rather than in command.h, which another change owns).
 Command InflightAlignCommand();
 Command InflightMcCommand();
+// cmd_transfer.cc
+Command TransferAlignCommand();
+Command TransferAlignAnsflCommand();  // cmd_transfer_ansfl.cc
 
 namespace {
 
 std::vector<Command> AllCommands() {
   return {InfoCommand(),     ConvertCommand(),  InsCommand(),   SimulateCommand(),
           AllanCommand(),    NavigateCommand(), SmoothCommand(),  LevelCommand(),
-          LevelMcCommand(),  InflightAlignCommand(), InflightMcCommand()};
+          LevelMcCommand(),  InflightAlignCommand(), InflightMcCommand(), TransferAlignCommand(), TransferAlignAnsflCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {

@@ -1,0 +1,67 @@
+// Transfer alignment on the real ANSFL quadrotor flights (issue 6 evidence): the DJI flight
+// controller's RTK-GNSS/INS solution (GT.csv with GTExtended.csv beside it: 10 Hz attitude,
+// velocity, position) is the master; each Xsens DOT IMU (IMU_k.csv, 120 Hz, its own axes
+// with z up) is a slave whose mounting R_b_s and clock offset are unknown. The mounting is
+// far from identity (the DOTs' axes are about forward-left-up: 180 deg about x from the
+// drone's FRD, plus a few degrees), so a coarse solution comes first:
+//  - clock offset: the lag maximising the correlation of |omega| of the DOT gyro with the
+//    body rate magnitude differenced from the GT attitude, searched over +-max_offset_s;
+//  - mounting: the rotation that best maps the DOT's angular rates onto the GT body rates
+//    at that lag (Wahba's problem solved by SVD, Kabsch, with the DOT gyro bias as the
+//    centroid offset: the DOTs' biases are 0.5-2 deg/s), which needs rotation about two
+//    axes at least (checked: a report instead of a number when the rates span a line);
+// then the transfer-alignment method refines mounting and delay (the delay here is the
+// residual clock offset plus the DJI solution's own latency).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "problems/transfer_alignment/config.h"
+#include "problems/transfer_alignment/inputs.h"
+#include "problems/transfer_alignment/run.h"
+
+namespace navtwin::transfer {
+
+struct CoarseAlignment {
+  double clock_offset_s = 0.0;   ///< add to the DOT times to put them on the GT time scale
+  Eigen::Quaterniond mounting = Eigen::Quaterniond::Identity();  ///< R_b_s
+  /// DOT gyro bias (DOT axes): omega_b = R_b_s (omega_s - bias) over the fit.
+  Eigen::Vector3d gyro_bias_s_radps = Eigen::Vector3d::Zero();
+  double rate_residual_rms_radps = 0.0;  ///< of R_b_s (omega_s - bias) - omega_b after the fit
+  double correlation = 0.0;              ///< of the |omega| series at the chosen lag
+};
+
+/// Coarse clock offset and mounting from the DOT gyro and the GT attitude. Throws
+/// std::runtime_error with the reason when the rotation does not excite two axes.
+CoarseAlignment CoarseAlignAnsfl(const std::vector<ImuSample>& dot_imu, const std::vector<NavState>& gt,
+                                 double max_offset_s = 2.0);
+
+/// Inputs for one path folder and one DOT (1-4): GT.csv (master, tags = GT times), IMU_k.csv
+/// shifted by the coarse clock offset and with the coarse gyro bias removed, the coarse
+/// mounting as misalignment guess, the slave initial state from the first GT record inside
+/// the DOT record. No truth (the result is scored by repeatability).
+TransferInputs LoadAnsflPath(const std::string& path_dir, int dot, CoarseAlignment* coarse = nullptr);
+
+struct AnsflAlignment {
+  std::string path;      ///< e.g. "StraightLine/path_1"
+  int dot = 0;
+  CoarseAlignment coarse;
+  TransferResult result;  ///< misalignment, delay with sigma
+  /// RMS of the attitude matching residual after alignment (slave vs master x mounting), mrad.
+  double residual_attitude_mrad = 0.0;
+  std::string note;       ///< why a run was skipped or is unreliable
+};
+
+/// Configuration for the DOT slaves against the DJI master (values and their sources in
+/// ansfl.cc and docs/transfer-alignment-real.md).
+TransferConfig AnsflDotConfig();
+
+/// Every StraightLine/path_* and Horizontal/path_* under data_dir and every IMU_k.csv in
+/// it, with the given method. Progress on stderr.
+std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const TransferConfig& config, Method method);
+
+}  // namespace navtwin::transfer

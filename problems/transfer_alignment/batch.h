@@ -1,0 +1,44 @@
+// The batch twin of transfer alignment (issue 6): one Ceres problem over the whole record.
+// Unknowns: slave navigation states (position, velocity, attitude R_n_s) every
+// config.batch_state_interval_s at master records, the slave IMU biases (constant), the
+// misalignment R_b_s (AttitudeManifold) and the delay tau (1, continuous). Residuals:
+// IMU preintegration between consecutive states (factors/imu_preintegration.h), and at
+// each state's master record the attitude and velocity matching residuals of
+// core/transfer_delay_model.h (second order, master derivatives kCentral; the delay enters through the
+// compensation series, which is differentiable in tau) whitened by the master noise,
+// plus bias priors. The initial values come from the order-2 filter. Standard deviations
+// of the misalignment and the delay from ceres::Covariance. The matching residual
+// functor lives in factors/transfer_match.h (AutoDiff; checked against central
+// differences).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "problems/transfer_alignment/config.h"
+#include "problems/transfer_alignment/filter.h"
+#include "problems/transfer_alignment/inputs.h"
+
+namespace navtwin::transfer {
+
+struct TransferBatchSolution {
+  Eigen::Quaterniond misalignment = Eigen::Quaterniond::Identity();  ///< R_b_s
+  Eigen::Vector3d misalignment_sigma_rad = Eigen::Vector3d::Zero();  ///< tangent (master body) axes
+  double delay_s = 0.0;
+  double delay_sigma_s = 0.0;
+  Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
+  std::vector<NavState> states;  ///< the smoothed slave states (attitude R_n_s)
+  int iterations = 0;
+  double final_cost = 0.0;
+  double run_time_s = 0.0;
+};
+
+/// Solves the batch, starting from `start` (normally the order-2 filter run on the same
+/// inputs). Throws std::runtime_error if Ceres fails or the covariance is rank-deficient.
+TransferBatchSolution SolveTransferBatch(const TransferInputs& inputs, const TransferConfig& config,
+                                         const TransferFilterRun& start);
+
+}  // namespace navtwin::transfer

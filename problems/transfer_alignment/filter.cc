@@ -1,0 +1,387 @@
+// The seed's 10-state transfer-alignment filter (filter.h; docs/transfer-alignment.md,
+// "The filter").
+//
+// Nominal state: the slave INS (core/strapdown.h on the raw slave IMU, attitude R_n_s),
+// the misalignment estimate M = R_b_s and the delay estimate tau. Error state (true minus
+// estimate): dx = [dv_n (3), phi_n (3), mu_b (3), dtau (1)] with
+//   v_true = v + dv,  R_n_s_true = Exp(phi) R_n_s,  M_true = Exp(mu) M,  tau_true = tau + dtau.
+//
+// Propagation, per IMU sample (or part of one, when a master tag splits it): dv and phi
+// follow the INS error model of problems/gnss_ins/error_dynamics.h (its dv/phi rows and
+// columns; the position errors are left out because the position is reset from the master
+// at every record, and the slave biases are not states), mu and dtau are random constants
+// with small random walks. Phi = I + F dt + (F dt)^2 / 2; Qd = diag(q) dt with
+//   q_v   = VRW^2 + sigma_ba^2 T_b,   q_phi = ARW^2 + sigma_bg^2 T_b,
+// where the unestimated bias is covered by white noise whose variance grows like the
+// bias's effect over the filter's memory T_b: sigma_b^2 T_b^2 = q T_b.
+//
+// Update at every master record whose tag lies inside the slave span: the INS is stepped
+// to the tag, its position reset from the record carried forward over tau (the record
+// holds the master's position at tag - tau), and the matching residuals of core/transfer_delay_model.h
+//   r = [v_s - v_pred(tau) - R_pred (omega x l);  Log(R_n_s (R_pred(tau) M)^T)]
+// evaluated at the estimate. At the truth r = 0 + noise, so 0 ~ r + H dx + v and the
+// innovation is y = -r ~ H dx (H = dr/d(dx), MatchResidualAndJacobian), relinearised
+// (iterated EKF, kUpdateIterations) because the delay enters through Exp(omega tau).
+// Measurement noise per axis (MeasurementSigma): the master's (config.master_velocity_mps
+// through the differentiator's noise gain for order 2, master_attitude_mrad) combined with
+// the compensation's truncation error, estimated by the first neglected term of the series
+// at tau_eff = |tau| + sigma_tau (order 1: |omega_dot| tau^2/2 and |a| tau + |a_dot| tau^2/2;
+// order 2: |omega_ddot| tau^3/6 and |a_ddot| tau^3/6, third derivatives by a backward
+// difference). On the preset the series' real error is larger still (omega tau to 1.9 rad),
+// and a chi-square gate then rejects the records that carry the delay (the delay is not
+// acquired: delay 3-70 ms at gate probabilities 0.9999 to 0.99999999), so the gate is off (kGateProbability).
+// Whitened and passed to the project's Joseph-form ESKF (solvers/eskf.h). Feedback:
+// v += dv, q_n_s <- Exp(phi) q_n_s, M <- Exp(mu) M, tau += dtau; the error state is zero again.
+#include "problems/transfer_alignment/filter.h"
+
+#include <chrono>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Cholesky>
+
+#include "core/earth.h"
+#include "core/imu_split.h"
+#include "core/rotation.h"
+#include "core/strapdown.h"
+#include "problems/gnss_ins/error_dynamics.h"
+#include "problems/gnss_ins/ins_state.h"
+#include "problems/transfer_alignment/master.h"
+#include "solvers/eskf.h"
+
+namespace navtwin::transfer {
+namespace {
+
+// Records in the master-derivative fit window (config.h master_fit_window_s): the window
+// over the median record spacing, at least 3; 0 (differences) for a zero window.
+int FitRecords(const std::vector<NavState>& master, double window_s) {
+  if (!(window_s > 0.0) || master.size() < 3) return 0;
+  std::vector<double> dts;
+  for (std::size_t k = 1; k < master.size(); ++k) dts.push_back(master[k].t_s - master[k - 1].t_s);
+  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
+  const double dt = dts[dts.size() / 2];
+  if (!(dt > 0.0)) return 0;
+  return std::max(3, static_cast<int>(std::lround(window_s / dt)) + 1);
+}
+
+
+using Matrix10 = Eigen::Matrix<double, kTransferStates, kTransferStates>;
+using Vector10 = Eigen::Matrix<double, kTransferStates, 1>;
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// Error-state blocks.
+constexpr int kVel = 0;
+constexpr int kAtt = 3;
+constexpr int kMis = 6;
+constexpr int kTau = 9;
+
+constexpr double kDegPerHour = kDegToRad / 3600.0;
+constexpr double kPerSqrtHour = 1.0 / 60.0;  // 1/sqrt(h) = 1/(60 sqrt(s))
+constexpr double kMicroG = 9.80665e-6;
+// Memory over which an unestimated slave bias is covered by process noise (see the header
+// comment): the attitude matching observes phi at 50 Hz, so the filter's memory of phi is
+// seconds; 10 s makes the bias term about equal to the tactical ARW term.
+constexpr double kBiasMemory_s = 10.0;
+// Random walks of the misalignment (structural flexure) and of the delay (clock wander):
+// 1 urad/sqrt(s) gives 14 urad over 200 s, 10 us/sqrt(s) 0.14 ms, both far below what the
+// filter resolves, so they only keep the gains from vanishing.
+constexpr double kMisalignmentWalk_rad_sqrt_s = 1e-6;
+constexpr double kDelayWalk_s_sqrt_s = 1e-5;
+constexpr double kTimeEpsilon_s = 1e-9;
+constexpr double kGateProbability = 1.0;  // no gate: see the header comment
+constexpr int kUpdateIterations = 3;
+
+// SO(3) Jacobians (rotation-vector calculus):
+//   Exp(x + d) = Exp(x) Exp(Jr(x) d) + O(d^2),   Log(Exp(x) Exp(d)) = x + Jr^-1(x) d,
+//   Log(Exp(d) Exp(x)) = x + Jl^-1(x) d,  Jl(x) = Jr(-x).
+Matrix3d RightJacobian(const Vector3d& x) {
+  const double t2 = x.squaredNorm();
+  const Matrix3d S = Skew<double>(x);
+  if (t2 < 1e-10) return Matrix3d::Identity() - 0.5 * S + S * S / 6.0;
+  const double t = std::sqrt(t2);
+  return Matrix3d::Identity() - (1.0 - std::cos(t)) / t2 * S + (t - std::sin(t)) / (t2 * t) * S * S;
+}
+
+Matrix3d InverseRightJacobian(const Vector3d& x) {
+  const double t2 = x.squaredNorm();
+  const Matrix3d S = Skew<double>(x);
+  if (t2 < 1e-10) return Matrix3d::Identity() + 0.5 * S + S * S / 12.0;
+  const double t = std::sqrt(t2);
+  const double c = 1.0 / t2 - (1.0 + std::cos(t)) / (2.0 * t * std::sin(t));
+  return Matrix3d::Identity() + 0.5 * S + c * S * S;
+}
+
+void Require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("RunTransferFilter: configuration: " + what);
+}
+
+void CheckConfig(const TransferConfig& c) {
+  auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
+  auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  Require(non_negative(c.gyro_bias_deg_h), "gyro_bias_deg_h must be >= 0");
+  Require(non_negative(c.gyro_arw_deg_sqrt_h), "gyro_arw_deg_sqrt_h must be >= 0");
+  Require(non_negative(c.accel_bias_ug), "accel_bias_ug must be >= 0");
+  Require(non_negative(c.accel_vrw_m_s_sqrt_h), "accel_vrw_m_s_sqrt_h must be >= 0");
+  Require(positive(c.initial_velocity_mps), "initial_velocity_mps must be > 0");
+  Require(positive(c.initial_attitude_deg), "initial_attitude_deg must be > 0");
+  Require(positive(c.misalignment_deg), "misalignment_deg must be > 0");
+  Require(positive(c.delay_s), "delay_s must be > 0");
+  Require(std::isfinite(c.delay_initial_s), "delay_initial_s must be finite");
+  Require(positive(c.master_attitude_mrad), "master_attitude_mrad must be > 0");
+  Require(positive(c.master_velocity_mps), "master_velocity_mps must be > 0");
+  Require(c.lever_arm_b_m.allFinite(), "lever_arm_b_m must be finite");
+}
+
+// The master record's position carried forward over tau with its velocity (local NED
+// offset v tau on the ellipsoid's radii; metres of error at most, which the velocity
+// dynamics barely feel).
+void ResetPosition(const NavState& record, double tau_s, NavState* slave) {
+  const double lat = record.lat_rad, h = record.h_m;
+  const Vector3d d_n_m = record.v_n_mps * tau_s;
+  slave->lat_rad = lat + d_n_m.x() / (wgs84::MeridianRadius(lat) + h);
+  slave->lon_rad = record.lon_rad + d_n_m.y() / ((wgs84::PrimeVerticalRadius(lat) + h) * std::cos(lat));
+  slave->h_m = h - d_n_m.z();
+}
+
+class TransferFilter {
+ public:
+  TransferFilter(const TransferInputs& in, const TransferConfig& cfg, DelayOrder order)
+      : in_(in), cfg_(cfg), order_(order), master_(in.master, DerivativeMode::kCausal, in.master_path, FitRecords(in.master, cfg.master_fit_window_s)),
+        ins_(in.slave_initial), kf_(InitialCovariance(cfg)) {
+    misalignment_ = in.misalignment_guess.normalized();
+    tau_s_ = cfg.delay_initial_s;
+    noise_.gyro_arw_rad_per_sqrt_s = cfg.gyro_arw_deg_sqrt_h * kDegToRad * kPerSqrtHour;
+    noise_.accel_vrw_mps_per_sqrt_s = cfg.accel_vrw_m_s_sqrt_h * kPerSqrtHour;
+    const double bg = cfg.gyro_bias_deg_h * kDegPerHour, ba = cfg.accel_bias_ug * kMicroG;
+    q_.segment<3>(kVel).setConstant(std::pow(noise_.accel_vrw_mps_per_sqrt_s, 2) + ba * ba * kBiasMemory_s);
+    q_.segment<3>(kAtt).setConstant(std::pow(noise_.gyro_arw_rad_per_sqrt_s, 2) + bg * bg * kBiasMemory_s);
+    q_.segment<3>(kMis).setConstant(kMisalignmentWalk_rad_sqrt_s * kMisalignmentWalk_rad_sqrt_s);
+    q_(kTau) = kDelayWalk_s_sqrt_s * kDelayWalk_s_sqrt_s;
+  }
+
+  void Run(TransferFilterRun* out) {
+    const double t_end = in_.slave_imu.back().t_s;
+    std::size_t next = 0;  // next master record to use
+    // Records before the slave's start are outside its span.
+    while (next < master_.size() && master_.record(next).t_s < ins_.state().t_s - kTimeEpsilon_s) ++next;
+    auto update_due = [&](double t_s) {
+      return next < master_.size() && master_.record(next).t_s <= t_s + kTimeEpsilon_s &&
+             master_.record(next).t_s <= t_end + kTimeEpsilon_s;
+    };
+    // A record at the initial time.
+    while (update_due(ins_.state().t_s)) Update(next++, out);
+    for (const ImuSample& raw : in_.slave_imu) {
+      const double t_ins = ins_.state().t_s;
+      if (raw.t_s <= t_ins + kTimeEpsilon_s) continue;  // before the start
+      ImuSample cur = raw;
+      if (cur.t_s - cur.dt_s < t_ins - kTimeEpsilon_s) cur = SplitImuSample(cur, t_ins).second;
+      // Records tagged inside the sample: split at the tag.
+      while (update_due(cur.t_s) && master_.record(next).t_s < cur.t_s - kTimeEpsilon_s) {
+        const double tag = master_.record(next).t_s;
+        if (tag > ins_.state().t_s + kTimeEpsilon_s) {
+          auto parts = SplitImuSample(cur, tag);
+          Propagate(parts.first);
+          cur = parts.second;
+        }
+        Update(next++, out);
+      }
+      Propagate(cur);
+      while (update_due(cur.t_s)) Update(next++, out);
+    }
+  }
+
+ private:
+  static Eigen::MatrixXd InitialCovariance(const TransferConfig& c) {
+    CheckConfig(c);
+    Vector10 sd;
+    sd.segment<3>(kVel).setConstant(c.initial_velocity_mps);
+    sd.segment<3>(kAtt).setConstant(c.initial_attitude_deg * kDegToRad);
+    sd.segment<3>(kMis).setConstant(c.misalignment_deg * kDegToRad);
+    sd(kTau) = c.delay_s;
+    return Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal());
+  }
+
+  void Propagate(const ImuSample& s) {
+    const double dt = s.dt_s;
+    gnss_ins::InsState x;
+    x.nav = ins_.state();
+    const Vector3d f_s = s.dv_b_mps / dt, w_s = s.dtheta_b_rad / dt;
+    const Eigen::MatrixXd F15 = gnss_ins::ErrorDynamicsF(x, f_s, w_s, noise_, gnss_ins::err::kSize15);
+    Matrix10 F = Matrix10::Zero();
+    F.block<3, 3>(kVel, kVel) = F15.block<3, 3>(gnss_ins::err::kVel, gnss_ins::err::kVel);
+    F.block<3, 3>(kVel, kAtt) = F15.block<3, 3>(gnss_ins::err::kVel, gnss_ins::err::kAtt);
+    F.block<3, 3>(kAtt, kVel) = F15.block<3, 3>(gnss_ins::err::kAtt, gnss_ins::err::kVel);
+    F.block<3, 3>(kAtt, kAtt) = F15.block<3, 3>(gnss_ins::err::kAtt, gnss_ins::err::kAtt);
+    const Matrix10 Fdt = F * dt;
+    const Matrix10 Phi = Matrix10::Identity() + Fdt + 0.5 * Fdt * Fdt;
+    const Matrix10 Qd = Matrix10((q_ * dt).asDiagonal());
+    kf_.Predict(Phi, Qd);
+    ins_.Update(s);
+  }
+
+  void Update(std::size_t k, TransferFilterRun* out) {
+    const MasterKinematics& kin = master_.kinematics(k);
+    NavState s = ins_.state();
+    ResetPosition(master_.record(k), tau_s_, &s);
+    const Eigen::Matrix<double, 6, 1> sigma = MeasurementSigma(k);
+    const Eigen::Matrix<double, 6, 1> inv_sigma = sigma.cwiseInverse();
+    // Iterated update (Gauss-Newton on the prior plus this record): relinearise at
+    // x0 (+) dx_i; dx_{i+1} = K_i (y_i + H_i dx_i), K_i = P H_i^T (H_i P H_i^T + I)^-1
+    // (whitened). The delay enters through Exp(omega tau) with omega tau up to ~0.5 rad on
+    // the preset, so one linearisation at a poor delay estimate overshoots. The last
+    // iteration goes through the ESKF engine (gate, Joseph form) with y + H dx_i.
+    Eigen::Matrix<double, 6, 1> r, r0;
+    Eigen::Matrix<double, 6, kTransferStates> H;
+    Vector10 dx_i = Vector10::Zero();
+    Eigen::MatrixXd Hw;
+    Eigen::VectorXd y;
+    for (int it = 0; it < kUpdateIterations; ++it) {
+      const Eigen::Quaterniond q_i = ApplyAttitudeError<double>(Vector3d(dx_i.segment<3>(kAtt)), s.q_n_b);
+      const Eigen::Quaterniond m_i = ApplyAttitudeError<double>(Vector3d(dx_i.segment<3>(kMis)), misalignment_);
+      MatchResidualAndJacobian(q_i.toRotationMatrix(), s.v_n_mps + dx_i.segment<3>(kVel), m_i.toRotationMatrix(), kin,
+                               tau_s_ + dx_i(kTau), order_, cfg_.lever_arm_b_m, &r, &H);
+      if (it == 0) r0 = r;
+      Hw = inv_sigma.asDiagonal() * H;
+      y = -r.cwiseProduct(inv_sigma) + Hw * dx_i;
+      if (it + 1 == kUpdateIterations) break;
+      const Eigen::MatrixXd& P = kf_.P();
+      const Eigen::MatrixXd S = Hw * P * Hw.transpose() + Eigen::MatrixXd::Identity(6, 6);
+      dx_i = P * Hw.transpose() * S.ldlt().solve(y);
+      if (!dx_i.allFinite()) Fail(kin.tag_s, "the iterated correction");
+    }
+    r = r0;
+    const ErrorStateKalmanFilter::Update u = kf_.Correct(y, Hw, kGateProbability);
+    const Eigen::VectorXd& dx = u.dx;
+    if (!dx.allFinite()) Fail(kin.tag_s, "the state correction");
+    // Feedback (the error state is zero again afterwards).
+    s.v_n_mps += dx.segment<3>(kVel);
+    s.q_n_b = ApplyAttitudeError<double>(dx.segment<3>(kAtt), s.q_n_b);
+    ins_.SetState(s);
+    misalignment_ = ApplyAttitudeError<double>(dx.segment<3>(kMis), misalignment_);
+    tau_s_ += dx(kTau);
+    if (!s.v_n_mps.allFinite() || !s.q_n_b.coeffs().allFinite() || !std::isfinite(tau_s_)) {
+      Fail(kin.tag_s, "the slave state");
+    }
+    TransferEpoch e;
+    e.t_s = kin.tag_s;
+    e.slave = s;
+    e.slave.t_s = kin.tag_s;
+    e.misalignment = misalignment_;
+    e.delay_s = tau_s_;
+    e.sigma = kf_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
+    e.innovation = -r;
+    out->epochs.push_back(e);
+  }
+
+  // Per-axis 1-sigma of the velocity and attitude matching at record k (see the header
+  // comment, "measurement noise"): the master's noise, the velocity noise through the
+  // differentiator's gain, and the truncation error of the compensation series estimated
+  // by its first neglected term at the delay tau_eff = |tau| + sigma_tau.
+  Eigen::Matrix<double, 6, 1> MeasurementSigma(std::size_t k) const {
+    const MasterKinematics& m = master_.kinematics(k);
+    const double tau = std::abs(tau_s_) + std::sqrt(kf_.P()(kTau, kTau));
+    // Third derivatives by a backward difference of the second (record k-1 when it exists).
+    Vector3d omega_ddot = Vector3d::Zero(), a_ddot = Vector3d::Zero();
+    double dt = 0.0;
+    if (k > 0) {
+      const MasterKinematics& p = master_.kinematics(k - 1);
+      dt = m.tag_s - p.tag_s;
+      omega_ddot = (m.omega_dot_nb_b_radps2 - p.omega_dot_nb_b_radps2) / dt;
+      a_ddot = (m.a_dot_n_mps3 - p.a_dot_n_mps3) / dt;
+    }
+    double trunc_att = 0.0, trunc_vel = 0.0, gain_v = 1.0;
+    if (order_ == DelayOrder::kFirst) {
+      trunc_att = m.omega_dot_nb_b_radps2.norm() * tau * tau / 2.0;
+      trunc_vel = m.a_n_mps2.norm() * tau + m.a_dot_n_mps3.norm() * tau * tau / 2.0;
+    } else {
+      trunc_att = omega_ddot.norm() * tau * tau * tau / 6.0;
+      trunc_vel = a_ddot.norm() * tau * tau * tau / 6.0;
+      // The weights of the v_j in v_k + tau a_k + tau^2/2 a_dot_k (differences or the fit).
+      gain_v = master_.VelocityNoiseGain(tau, order_);
+    }
+    Eigen::Matrix<double, 6, 1> sigma;
+    sigma.head<3>().setConstant(std::hypot(gain_v * cfg_.master_velocity_mps, trunc_vel));
+    sigma.tail<3>().setConstant(std::hypot(cfg_.master_attitude_mrad * 1e-3, trunc_att));
+    return sigma;
+  }
+
+  [[noreturn]] static void Fail(double t_s, const char* what) {
+    std::ostringstream m;
+    m << "RunTransferFilter: " << what << " became non-finite at t = " << t_s << " s";
+    throw std::runtime_error(m.str());
+  }
+
+  const TransferInputs& in_;
+  const TransferConfig& cfg_;
+  DelayOrder order_;
+  MasterStream master_;
+  Strapdown ins_;
+  ErrorStateKalmanFilter kf_;
+  Eigen::Quaterniond misalignment_;
+  double tau_s_ = 0.0;
+  gnss_ins::ImuNoise noise_;
+  Vector10 q_ = Vector10::Zero();  // continuous process-noise PSD per state
+};
+
+}  // namespace
+
+void MatchResidualAndJacobian(const Matrix3d& R_n_s, const Vector3d& v_n_s_mps, const Matrix3d& R_b_s,
+                              const MasterKinematics& m, double tau_s, DelayOrder order,
+                              const Vector3d& lever_arm_b_m, Eigen::Matrix<double, 6, 1>* r,
+                              Eigen::Matrix<double, 6, kTransferStates>* H) {
+  // Residuals from the one model (core/transfer_delay_model.h).
+  r->head<3>() = VelocityMatchResidual<double>(v_n_s_mps, m, tau_s, order, lever_arm_b_m);
+  const Vector3d r_att = AttitudeMatchResidual<double>(R_n_s, R_b_s, m, tau_s, order);
+  r->tail<3>() = r_att;
+
+  // C = R_n_b_pred = R_n_b Exp(theta(tau)); d theta / d tau = omega (+ omega_dot tau).
+  const Vector3d theta = DelayRotationVector<double>(m, tau_s, order);
+  Vector3d dtheta_dtau = m.omega_nb_b_radps;
+  if (order == DelayOrder::kSecond) dtheta_dtau += m.omega_dot_nb_b_radps2 * tau_s;
+  const Matrix3d C = CompensatedMasterDcm<double>(m, tau_s, order);
+  // C(tau + d) = C Exp(u d) with u = Jr(theta) dtheta/dtau (body axes of the prediction).
+  const Vector3d u = RightJacobian(theta) * dtheta_dtau;
+
+  H->setZero();
+  // Velocity rows. d r_vel / d dv = I.
+  H->block<3, 3>(0, kVel).setIdentity();
+  // d r_vel / d tau: -(a + a_dot tau) for order 2 (order 1 holds v constant); the lever
+  // term -C w, w = omega x l: C(tau + d) w = C Exp(u d) w = C w + C (u x w) d
+  // = C w - C [w x] u d, so it contributes +C [w x] u.
+  Vector3d dv_dtau = Vector3d::Zero();
+  if (order == DelayOrder::kSecond) dv_dtau = m.a_n_mps2 + m.a_dot_n_mps3 * tau_s;
+  Vector3d h_tau_v = -dv_dtau;
+  if (!lever_arm_b_m.isZero()) {
+    const Vector3d w_l = m.omega_nb_b_radps.cross(lever_arm_b_m);
+    h_tau_v += C * Skew<double>(w_l) * u;
+  }
+  H->block<3, 1>(0, kTau) = h_tau_v;
+
+  // Attitude rows, r = Log(E), E = R_n_s M^T C^T = Exp(r_att).
+  //   phi: Log(Exp(phi) E) = r + Jl^-1(r) phi, Jl^-1(r) = Jr^-1(-r).
+  //   mu:  (Exp(mu) M)^T = M^T Exp(-mu), and R_n_s M^T Exp(-mu) C^T = E C Exp(-mu) C^T
+  //        = E Exp(-C mu): Log(E Exp(-C mu)) = r - Jr^-1(r) C mu.
+  //   tau: C(tau + d)^T = Exp(-u d) C^T, so E -> E C Exp(-u d) C^T = E Exp(-C u d):
+  //        d r / d tau = -Jr^-1(r) C u.
+  const Matrix3d Jr_inv = InverseRightJacobian(r_att);
+  H->block<3, 3>(3, kAtt) = InverseRightJacobian(-r_att);
+  H->block<3, 3>(3, kMis) = -Jr_inv * C;
+  H->block<3, 1>(3, kTau) = -Jr_inv * C * u;
+}
+
+TransferFilterRun RunTransferFilter(const TransferInputs& inputs, const TransferConfig& config, DelayOrder order) {
+  const auto start = std::chrono::steady_clock::now();
+  ValidateInputs(inputs);
+  TransferFilterRun run;
+  run.order = order;
+  TransferFilter filter(inputs, config, order);
+  filter.Run(&run);
+  run.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+}  // namespace navtwin::transfer

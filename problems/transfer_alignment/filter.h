@@ -1,0 +1,64 @@
+// The seed's transfer-alignment Kalman filter (seed 002, figure 1): 10 states
+//   [0,3) dv_n_mps     slave velocity error (true minus estimate)
+//   [3,6) phi_n_rad    slave attitude error, R_n_s_true = Exp(phi) R_n_s_est (core/rotation.h)
+//   [6,9) mu_b_rad     misalignment residual, R_b_s_true = Exp(mu) R_b_s_est (master body axes)
+//   [9]   dtau_s       delay residual, tau_true = tau_est + dtau
+// with velocity matching (3) and attitude matching (3, rotation vector) against the
+// delay-compensated master (core/transfer_delay_model.h; order 1 or 2), at every master record. The
+// slave INS is the project's strapdown (core/strapdown.h) on the raw slave IMU; position
+// is taken from the master (transfer alignment matches velocity and attitude, and the
+// position errors over a minute barely enter the velocity dynamics). Feedback after each
+// update, as the seed: the velocity error into the slave velocity, the attitude error
+// rotation vector as a quaternion multiplied into the slave quaternion, the misalignment
+// and delay residuals accumulated into the estimates the matcher uses. Jacobians of the
+// two residuals with respect to the states: analytic, checked against autodiff of the
+// core/transfer_delay_model.h residuals in the tests. Process noise: slave ARW / VRW, small random walks
+// on misalignment and delay (flexure, clock wander; configurable).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "problems/transfer_alignment/config.h"
+#include "core/transfer_delay_model.h"
+#include "problems/transfer_alignment/inputs.h"
+
+namespace navtwin::transfer {
+
+constexpr int kTransferStates = 10;
+
+/// The filter's estimate after one master record.
+struct TransferEpoch {
+  double t_s = 0.0;                  ///< record tag = slave time of the update
+  NavState slave;                    ///< corrected slave INS state (attitude R_n_s)
+  Eigen::Quaterniond misalignment = Eigen::Quaterniond::Identity();  ///< R_b_s estimate
+  double delay_s = 0.0;
+  Eigen::Matrix<double, kTransferStates, 1> sigma;  ///< sqrt diag P after the update
+  Eigen::Matrix<double, 6, 1> innovation;           ///< [velocity m/s, attitude rad]
+};
+
+struct TransferFilterRun {
+  DelayOrder order = DelayOrder::kSecond;
+  std::vector<TransferEpoch> epochs;  ///< one per master record inside the slave IMU span
+  double run_time_s = 0.0;
+};
+
+/// The matching residuals of core/transfer_delay_model.h at the estimate, r = [VelocityMatchResidual;
+/// AttitudeMatchResidual] (m/s, rad), and their analytic Jacobian H = dr/d(dx) with respect
+/// to the 10 error states above (exact: it includes the SO(3) Jacobians of the residual's
+/// Log and of the compensation's Exp; checked against autodiff in the tests). The filter's
+/// innovation is y = -r ~ H dx.
+void MatchResidualAndJacobian(const Eigen::Matrix3d& R_n_s, const Eigen::Vector3d& v_n_s_mps,
+                              const Eigen::Matrix3d& R_b_s, const MasterKinematics& master, double tau_s,
+                              DelayOrder order, const Eigen::Vector3d& lever_arm_b_m,
+                              Eigen::Matrix<double, 6, 1>* r,
+                              Eigen::Matrix<double, 6, kTransferStates>* H);
+
+/// Runs the filter (ValidateInputs first; MasterStream with kCausal derivatives). Throws
+/// InputError for bad inputs, std::invalid_argument for a bad configuration, and
+/// std::runtime_error naming the time if the state becomes non-finite.
+TransferFilterRun RunTransferFilter(const TransferInputs& inputs, const TransferConfig& config, DelayOrder order);
+
+}  // namespace navtwin::transfer

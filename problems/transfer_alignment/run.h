@@ -1,0 +1,62 @@
+// One entry point for the methods of issue 6 and their scores: the slave attitude error
+// against the truth (roll, pitch, heading, mrad, RMS and max after config.settle_s), the
+// delay and misalignment estimates with sigma, JSON and table outputs.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "problems/transfer_alignment/batch.h"
+#include "problems/transfer_alignment/config.h"
+#include "problems/transfer_alignment/filter.h"
+#include "problems/transfer_alignment/inputs.h"
+
+namespace navtwin::transfer {
+
+enum class Method { kOrder1, kOrder2, kBatch };
+const char* MethodName(Method m);  ///< "order1", "order2", "batch"
+Method ParseMethod(const std::string& name);  ///< throws std::invalid_argument listing the names
+
+struct TransferResult {
+  Method method = Method::kOrder2;
+  /// Slave attitude error (estimate vs truth R_n_b_true R_b_s_true), as a rotation vector
+  /// in the slave's own roll/pitch/heading sense: the ZYX Euler differences, mrad.
+  /// NaN without truth. Over the epochs after settle_s.
+  Eigen::Vector3d rms_mrad = Eigen::Vector3d::Constant(std::nan(""));
+  Eigen::Vector3d max_mrad = Eigen::Vector3d::Constant(std::nan(""));
+  double delay_s = 0.0;
+  double delay_sigma_s = 0.0;
+  Eigen::Vector3d misalignment_deg = Eigen::Vector3d::Zero();  ///< R_b_s as ZYX Euler (roll, pitch, yaw)
+  Eigen::Vector3d misalignment_sigma_mrad = Eigen::Vector3d::Zero();
+  double misalignment_error_mrad = std::nan("");  ///< |Log(R_true R_est^T)| when known
+  Eigen::Vector3d misalignment_true_deg = Eigen::Vector3d::Constant(std::nan(""));  ///< when known
+  double delay_true_s = std::nan("");  ///< when known
+  /// What the errors were scored against ("slave truth", "body truth: ..."), or why not.
+  std::string note;
+  double run_time_s = 0.0;
+  /// Per epoch: t_s and the attitude error (mrad) for plots.
+  std::vector<double> t_s;
+  std::vector<Eigen::Vector3d> error_mrad;
+};
+
+/// Fills r's attitude scores from slave states (t_s, q_n_b = R_n_s estimate): per state the
+/// error Euler(R_n_s_est) - Euler(R_n_s_true) wrapped to (-pi, pi], mrad, with R_n_s_true =
+/// R_n_b_truth(t) R_b_s_true (truth slerped at t; states outside the truth are skipped);
+/// without the true misalignment R_n_s_est M_est^T is scored against R_n_b_truth. RMS / max
+/// over the states at or after inputs.slave_initial.t_s + settle_s. Also sets
+/// misalignment_true_deg, misalignment_error_mrad, delay_true_s and note.
+void ScoreAttitude(const TransferInputs& inputs, const std::vector<NavState>& slave_states,
+                   const Eigen::Quaterniond& misalignment_est, double settle_s, TransferResult* r);
+
+TransferResult RunMethod(const TransferInputs& inputs, const TransferConfig& config, Method method);
+
+/// `--format=json`: {"method":..,"roll_rms_mrad":..,"pitch_rms_mrad":..,"heading_rms_mrad":..,
+/// "roll_max_mrad":..,"pitch_max_mrad":..,"heading_max_mrad":..,"delay_est_s":..,
+/// "delay_sigma_s":..,"misalignment_deg":[..],"run_time_s":..} plus extra keys; NaN -> null.
+std::string TransferResultJson(const TransferResult& r);
+std::string TransferResultTable(const TransferResult& r);
+
+}  // namespace navtwin::transfer

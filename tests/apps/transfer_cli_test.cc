@@ -1,0 +1,151 @@
+// End-to-end checks of `navtwin transfer-align` (issue 6): usage errors (exit 2 with the
+// usage line, nothing on stdout), the JSON of the issue on a shortened scenario given as a
+// YAML file (--scenario accepts a path; the preset itself runs in the evidence, not here),
+// the file mode with and without truth, and a malformed master file (exit 1, message with
+// the file and the line, nothing on stdout).
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/apps/cli_util.h"
+
+namespace navtwin {
+namespace {
+
+using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
+
+/// The preset's first 12 s (cruise 2 s, wing rock 10 s): the same slave IMU, master and
+/// init errors, short enough to run every method in about a second.
+constexpr const char* kShortScenario = R"(name: transfer-short
+start: {lat_deg: 36.0, lon_deg: 127.5, h_m: 3000}
+trajectory:
+  initial: {speed_mps: 200, heading_deg: 0}
+  segments:
+    - {kind: cruise, duration_s: 2}
+    - {kind: wing_rock, duration_s: 10, roll_amplitude_deg: 30, roll_frequency_hz: 0.5, pitch_amplitude_deg: 5, pitch_frequency_hz: 0.25, yaw_amplitude_deg: 5, yaw_frequency_hz: 0.25}
+imu:
+  rate_hz: 100
+  mounting_deg: [0.5, -0.3, 0.8]
+  errors:
+    gyro: {bias_deg_h: 1.0, arw_deg_sqrt_h: 0.05, scale_factor_ppm: 100, misalignment_arcsec: 20}
+    accel: {bias_ug: 200, vrw_m_s_sqrt_h: 0.05, scale_factor_ppm: 100, misalignment_arcsec: 20}
+master:
+  rate_hz: 50
+  transfer_delay_s: 0.3
+  attitude_error_sigma_mrad: 0.05
+  velocity_noise_mps: 0.01
+init_errors: {velocity_ned_mps: [0.5, -0.5, 0.2], attitude_deg: [0.5, -0.5, 1.0]}
+)";
+
+/// A folder with short.yaml (the scenario), settle.yaml (a configuration scoring after 4 s
+/// instead of 20 s) and the scenario's simulated files (seed 1); made once.
+const std::string& Folder() {
+  static const std::string dir = [] {
+    const std::string d = MakeTempDir("transfer_cli");
+    std::ofstream(d + "/short.yaml") << kShortScenario;
+    std::ofstream(d + "/settle.yaml") << "settle_s: 4\n";
+    const RunResult r = Navtwin("simulate --scenario " + d + "/short.yaml --seed 1 --out " + d);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return d;
+  }();
+  return dir;
+}
+
+TEST(TransferCliTest, MisuseIsAUsageError) {
+  const std::string s = "--scenario transfer-alignment-high-maneuver";
+  const std::string files = "--master m.nav --slave_imu imu.txt --init_from init.nav";
+  // Each fails before any simulation or reading.
+  const std::vector<std::string> misuse = {
+           "transfer-align " + s,                                   // no --method
+           "transfer-align --method order3 " + s,                   // unknown method
+           "transfer-align --method order2 --master m.nav " + s,    // --scenario with a file
+           "transfer-align --method order2 --delay_s -0.1 " + s,    // negative delay
+           std::string("transfer-align --method order2 --master m.nav --slave_imu imu.txt"),  // no --init_from
+           std::string("transfer-align --method order2 --slave_imu imu.txt --init_from i.nav"),  // no --master
+           "transfer-align --method order2 --seed 3 " + files,      // --seed without --scenario
+           "transfer-align --method order2 --delay_s 0.2 " + files,  // --delay_s without --scenario
+           "transfer-align --method batch extra " + s,              // positional argument
+           "transfer-align --method batch --imu a.txt " + s,        // a flag of another command
+  };
+  for (const std::string& args : misuse) {
+    const RunResult r = Navtwin(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("usage: navtwin transfer-align"), std::string::npos) << args << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+}
+
+TEST(TransferCliTest, ScenarioJsonHasTheIssuesKeys) {
+  const std::string d = Folder();
+  const RunResult r = Navtwin("transfer-align --scenario " + d + "/short.yaml --seed 1 --delay_s 0.2 --config " + d +
+                              "/settle.yaml --method all --format=json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // An array of the three methods' objects, each starting with the issue's keys in order.
+  EXPECT_EQ(r.out.rfind("[{\"method\":\"order1\",\"roll_rms_mrad\":", 0), 0u) << r.out;
+  for (const char* method : {"order1", "order2", "batch"}) {
+    const std::string anchor = std::string("{\"method\":\"") + method + "\"";
+    ASSERT_NE(r.out.find(anchor), std::string::npos) << method << "\n" << r.out;
+    for (const char* key : {"roll_rms_mrad", "pitch_rms_mrad", "heading_rms_mrad", "roll_max_mrad", "pitch_max_mrad",
+                            "heading_max_mrad", "delay_est_s", "delay_sigma_s", "run_time_s"}) {
+      EXPECT_TRUE(std::isfinite(JsonNumberAfter(r.out, anchor, key))) << method << " " << key << "\n" << r.out;
+    }
+    // The override reached the simulated master.
+    EXPECT_EQ(JsonNumberAfter(r.out, anchor, "delay_true_s"), 0.2) << method;
+    EXPECT_NE(r.out.find("\"misalignment_deg\":[", r.out.find(anchor)), std::string::npos) << method;
+    EXPECT_NE(r.err.find(std::string("transfer-align: running ") + method), std::string::npos) << r.err;  // progress
+  }
+  EXPECT_NE(r.err.find("transfer delay 0.2 s"), std::string::npos) << r.err;
+}
+
+TEST(TransferCliTest, FilesWithAndWithoutTruth) {
+  const std::string d = Folder();
+  const std::string files =
+      "--master " + d + "/master.nav --slave_imu " + d + "/imu.txt --init_from " + d + "/init.nav --config " + d +
+      "/settle.yaml --method order2";
+  RunResult r = Navtwin("transfer-align " + files + " --truth " + d + "/truth.nav");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("method order2"), std::string::npos) << r.out;
+  // Files carry no mounting: the body estimate is scored against the body truth.
+  EXPECT_NE(r.out.find("body truth"), std::string::npos) << r.out;
+  r = Navtwin("transfer-align " + files + " --format=json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"roll_rms_mrad\":null"), std::string::npos) << r.out;  // no truth
+  EXPECT_TRUE(std::isfinite(JsonNumberAfter(r.out, "{", "delay_est_s"))) << r.out;
+  EXPECT_NE(r.err.find("no --truth"), std::string::npos) << r.err;
+}
+
+TEST(TransferCliTest, MalformedMasterFileNamesFileAndLine) {
+  const std::string d = Folder();
+  // master.nav with its 5th line broken (a velocity that is not a number).
+  std::istringstream in(ReadAll(d + "/master.nav"));
+  const std::string bad = d + "/bad_master.nav";
+  {
+    std::ofstream out(bad);
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+      if (n == 5) {
+        std::istringstream fields(line);
+        std::vector<std::string> f;
+        for (std::string x; fields >> x;) f.push_back(x);
+        ASSERT_GE(f.size(), 6u);
+        f[5] = "fast";
+        line.clear();
+        for (const std::string& x : f) line += (line.empty() ? "" : " ") + x;
+      }
+      out << line << "\n";
+    }
+  }
+  const RunResult r = Navtwin("transfer-align --master " + bad + " --slave_imu " + d + "/imu.txt --init_from " + d +
+                              "/init.nav --method order2 --format=json");
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("line 5"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;  // no partial output
+}
+
+}  // namespace
+}  // namespace navtwin
