@@ -3,8 +3,10 @@
 # batch.dat: columns delay_ms method roll pitch heading RMS, roll pitch heading max (mrad),
 # delay estimate and sigma (ms), misalignment error (mrad)) and outdir.
 set terminal pngcairo size 900,900 font ",11"
-set output outdir.'/error_vs_delay.png'
-set multiplot layout 2,1 title "transfer-alignment-high-maneuver, seed 1: slave attitude error RMS (after settle\\_s) vs transfer delay"
+if (!exists("tag")) tag = ''
+if (!exists("scenario")) scenario = 'transfer-alignment-high-maneuver'
+set output outdir.'/error_vs_delay'.tag.'.png'
+set multiplot layout 2,1 title scenario.", seed 1: slave attitude error RMS (after settle\\_s) vs transfer delay"
 set grid
 set logscale y
 set format y "%g"

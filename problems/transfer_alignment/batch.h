@@ -2,8 +2,10 @@
 // Unknowns: slave navigation states (position, velocity, attitude R_n_s) every
 // config.batch_state_interval_s at master records, the slave IMU biases (constant), the
 // misalignment R_b_s (AttitudeManifold) and the delay tau (1, continuous). Residuals:
-// IMU preintegration between consecutive states (factors/imu_preintegration.h), and at
-// each state's master record the attitude and velocity matching residuals of
+// IMU preintegration between consecutive states (factors/imu_preintegration.h), and per
+// state, with the master record whose DATA time (tag - tau) is nearest the state (so the
+// series carries over at most half a record interval, not over tau; re-selected after
+// each solve at the new tau), the attitude and velocity matching residuals of
 // core/transfer_delay_model.h (second order, master derivatives kCentral; the delay enters through the
 // compensation series, which is differentiable in tau) whitened by the master noise,
 // plus bias priors. The initial values come from the order-2 filter. Standard deviations
