@@ -38,7 +38,7 @@ DECLARE_uint64(seed);       // cmd_simulate.cc
 DECLARE_int32(runs);        // cmd_level_mc.cc (default 10000 there; inflight-mc: 50 unless given)
 DECLARE_int32(threads);     // cmd_level_mc.cc
 DECLARE_string(errors_csv); // cmd_level_mc.cc
-DEFINE_string(method, "", "inflight-align: distance, kalman, batch or all (the three in turn)");
+DEFINE_string(method, "", "inflight-align: distance, kalman, batch or all; transfer-align: order1, order2, batch or all; transfer-align-ansfl: order2 or batch");
 DEFINE_string(track_csv, "",
               "inflight-align: write the heading track (t_s,path_length_km,yaw_deg,sigma_arcmin,error_arcmin) "
               "to this CSV; with --method all one file per method, the method's name before the extension");

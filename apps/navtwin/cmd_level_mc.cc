@@ -27,14 +27,14 @@ DECLARE_double(window_s);
 DECLARE_double(noise_mg);
 DECLARE_string(vib_axes);
 DECLARE_int32(vib_tones);
-DEFINE_int32(runs, 10000, "level-mc: number of Monte Carlo runs");
+DEFINE_int32(runs, 10000, "level-mc, inflight-mc: number of Monte Carlo runs (level-mc default 10000, inflight-mc 50)");
 DEFINE_double(rate_hz, 600.0, "level-mc: accelerometer sample rate, Hz");
 DEFINE_string(vib_freq_hz, "22:24", "level-mc: vibration fundamental, LO:HI (drawn uniformly per run) or one value, Hz");
 DEFINE_double(vib_amp_g, 1.0, "level-mc: 1 sigma of the zero-mean normal vibration amplitude, g");
 DEFINE_double(true_roll_deg, 0.0, "level-mc: true roll, deg");
 DEFINE_double(true_pitch_deg, 0.0, "level-mc: true pitch, deg");
-DEFINE_int32(threads, 2, "level-mc: worker threads (0: all cores); the results do not depend on it");
-DEFINE_string(errors_csv, "", "level-mc: write every run's roll and pitch error of every method (deg) to this CSV");
+DEFINE_int32(threads, 2, "level-mc, inflight-mc: worker threads (0: all cores); the results do not depend on it");
+DEFINE_string(errors_csv, "", "level-mc, inflight-mc: write every run's errors of every method to this CSV");
 DEFINE_bool(batch_covariance, false, "level-mc: batch standard deviations from ceres::Covariance in every run (slower)");
 
 namespace navtwin::app {

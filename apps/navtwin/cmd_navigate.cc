@@ -53,7 +53,7 @@ DECLARE_uint64(seed);
 DEFINE_string(gnss, "", "GNSS file: KF-GINS GNSS text, RTKLIB .pos or ULog");
 DEFINE_string(mag, "", "Magnetometer file (navtwin CSV, Xsens DOT raw, ULog); used when the configuration's mag.mode is not off");
 DEFINE_string(baro, "", "Barometer file (navtwin CSV, ULog); used when the configuration has baro.use");
-DEFINE_string(config, "", "navtwin YAML configuration (keys in docs/gnss-ins.md)");
+DEFINE_string(config, "", "YAML configuration (navigate, smooth: docs/gnss-ins.md; inflight-align: data/configs/inflight-mach07-south.yaml; transfer-align: data/configs/transfer-alignment-high-maneuver.yaml)");
 DEFINE_string(kfgins_config, "", "KF-GINS YAML configuration, taken unchanged (its imupath, gnsspath, outputpath are used when --imu, --gnss, --out are not given)");
 DEFINE_string(smoother, "", "navigate: rts = write the RTS-smoothed solution instead of the filter's");
 DEFINE_double(outage_start_s, NAN, "Injected GNSS outages for scoring: first outage start, s after the first IMU epoch");
