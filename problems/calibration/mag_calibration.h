@@ -1,0 +1,107 @@
+// Magnetometer calibration (seed 001 section 3, issue 8): hard and soft iron.
+//
+// Sensor model (the simulator's, core/sim/aiding.h): m = (I + S) m_b + h + n, with m_b the
+// Earth field in body axes (|m_b| = B everywhere), S the soft iron, h the hard iron, n noise.
+// Calibration: m_b ~ A (m - h), A = (I + S)^-1 up to a rotation; A is estimated SYMMETRIC
+// (6 unknowns: the rotation part of (I + S)^-1 cannot be seen from magnitudes alone and is
+// the IMU-to-magnetometer alignment, not iron), h has 3, and the field magnitude B is fixed
+// (given) or fitted with |A| scaled so that the mean corrected magnitude is B.
+//
+// Methods:
+//  - FitEllipsoid (3-axis, batch): Ceres least squares of r_i = |A (m_i - h)| - B over all
+//    samples with a robust loss (Huber or Cauchy, scale in uT), started from the algebraic
+//    ellipsoid fit (linear least squares on the quadric). Parameter sigmas from
+//    ceres::Covariance; a coverage check: the directions (m_i - h)/|m_i - h| must span the
+//    sphere enough (eigenvalues of their scatter), else std::runtime_error naming what is
+//    missing (e.g. "all samples near one plane: the axis normal to it is not calibrated").
+//  - RecursiveEllipsoidFit (3-axis, recursive): recursive least squares on the algebraic
+//    quadric parameters as samples arrive, with the same calibration available at any time.
+//  - FitBidirectional (the seed's 2-axis method): from a level turn of a 2-axis sensor, hard
+//    iron as the midpoint of opposite readings (pairs 180 deg apart in heading:
+//    h = (m(psi) + m(psi + 180))/2, taken from the extremes of each axis), soft iron as the
+//    x/y phase correction (the heading between the x and y maxima should be 90 deg; the
+//    seed's example is -15.32 deg) and a y/x scale; valid only while |roll|, |pitch| are
+//    within max_tilt (the seed: 2 deg keeps the heading error within 3 deg at 57 deg
+//    inclination); TiltErrorBound gives that relation.
+//  - Heading: TiltCompensatedHeading (3-axis, roll and pitch from the IMU) and
+//    LevelHeading (2-axis), both plus the declination to true north.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/types.h"
+
+namespace navtwin::calibration {
+
+struct MagCalibration {
+  Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();  ///< h
+  Eigen::Matrix3d correction = Eigen::Matrix3d::Identity();  ///< A (symmetric for the ellipsoid fit)
+  double field_uT = 0.0;                                     ///< B
+  Eigen::Vector3d hard_iron_sigma_uT = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 6, 1> correction_sigma = Eigen::Matrix<double, 6, 1>::Zero();  ///< A00 A01 A02 A11 A12 A22
+  double residual_rms_uT = 0.0;        ///< RMS of |A (m - h)| - B over the samples used
+  double field_spread_before_uT = 0.0; ///< std of |m| before calibration
+  double field_spread_after_uT = 0.0;  ///< std of |A (m - h)| after
+  int samples = 0;
+  int downweighted = 0;                ///< robust weight < 0.5
+  std::string method;                  ///< "ellipsoid", "recursive", "bidirectional"
+};
+
+/// A (m - h).
+Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector3d& m_uT);
+
+enum class MagLoss { kNone, kHuber, kCauchy };
+
+struct EllipsoidFitOptions {
+  MagLoss loss = MagLoss::kCauchy;
+  double loss_scale_uT = 2.0;
+  /// Field magnitude to scale to (uT); <= 0: keep the algebraic fit's mean magnitude.
+  double field_uT = 0.0;
+  int max_iterations = 50;
+  /// Smallest accepted ratio of the smallest to the largest eigenvalue of the direction
+  /// scatter (a full sphere has 1; a single plane 0).
+  double min_coverage = 0.02;
+};
+
+MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const EllipsoidFitOptions& options = {});
+
+class RecursiveEllipsoidFit {
+ public:
+  explicit RecursiveEllipsoidFit(double field_uT = 0.0);
+  void Add(const Eigen::Vector3d& m_uT);
+  int count() const { return count_; }
+  /// The calibration from the samples so far (needs >= 9 well-spread samples; throws
+  /// std::runtime_error otherwise).
+  MagCalibration Current() const;
+
+ private:
+  double field_uT_;
+  int count_ = 0;
+  Eigen::Matrix<double, 9, 9> P_;
+  Eigen::Matrix<double, 9, 1> theta_;
+};
+
+struct BidirectionalOptions {
+  double max_tilt_deg = 2.0;  ///< samples with |roll| or |pitch| above this are left out
+};
+
+/// 2-axis (x, y) calibration from samples taken during a level turn through at least 360
+/// deg; roll_pitch_rad[i] = (roll, pitch) of sample i (from the IMU; zeros if level).
+/// correction = [[1, 0, 0], [-sin(phase) * k, cos(phase) * k, 0], [0, 0, 1]]-style 2x2 block
+/// documented in the implementation. Throws std::runtime_error when the turn does not cover
+/// both extremes of both axes.
+MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std::vector<Eigen::Vector2d>& roll_pitch_rad,
+                                const BidirectionalOptions& options = {});
+
+/// Heading (rad, true north) from a calibrated 3-axis body-axis field, roll and pitch.
+double TiltCompensatedHeading(const Eigen::Vector3d& m_b_uT, double roll_rad, double pitch_rad, double declination_rad);
+/// Heading from the horizontal (x, y) components only (2-axis sensor, level).
+double LevelHeading(const Eigen::Vector3d& m_b_uT, double declination_rad);
+/// Largest heading error (rad) a 2-axis sensor makes at tilt t and inclination I:
+/// about t tan I (the seed: 2 deg at 57 deg -> 3.1 deg).
+double TiltErrorBound(double tilt_rad, double inclination_rad);
+
+}  // namespace navtwin::calibration
