@@ -1,8 +1,13 @@
 #include "core/sim/simulator.h"
 
+#include <stdlib.h>
+
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <memory>
+#include <stdexcept>
+#include <system_error>
 
 #include "core/io/atomic_file.h"
 #include "core/io/csv_mag_baro.h"
@@ -151,6 +156,26 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
   report.run_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return report;
+}
+
+TemporarySimulation::TemporarySimulation(const Scenario& scenario, const SimulationOptions& options,
+                                         const std::string& prefix) {
+  const std::filesystem::path tmp = std::filesystem::temp_directory_path();
+  std::string dir = (tmp / (prefix + "XXXXXX")).string();
+  if (::mkdtemp(dir.data()) == nullptr) throw std::runtime_error("cannot create a temporary folder in " + tmp.string());
+  dir_ = dir;
+  try {
+    report_ = Simulate(scenario, options, dir_);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+    throw;
+  }
+}
+
+TemporarySimulation::~TemporarySimulation() {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);
 }
 
 }  // namespace navtwin::sim

@@ -40,4 +40,25 @@ struct SimulationReport {
 SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& options,
                           const std::string& out_dir);
 
+/// A scenario simulated into a fresh temporary folder (under the system's temporary
+/// directory, named prefix + random suffix), removed with this object: for commands that
+/// simulate and then read the files back as a user would. Throws std::runtime_error when
+/// the folder cannot be created, and what Simulate throws.
+class TemporarySimulation {
+ public:
+  TemporarySimulation(const Scenario& scenario, const SimulationOptions& options, const std::string& prefix);
+  ~TemporarySimulation();
+  TemporarySimulation(const TemporarySimulation&) = delete;
+  TemporarySimulation& operator=(const TemporarySimulation&) = delete;
+
+  const std::string& dir() const { return dir_; }
+  /// dir() + "/" + file (e.g. "imu.txt").
+  std::string path(const std::string& file) const { return dir_ + "/" + file; }
+  const SimulationReport& report() const { return report_; }
+
+ private:
+  std::string dir_;
+  SimulationReport report_;
+};
+
 }  // namespace navtwin::sim

@@ -79,6 +79,26 @@ double ConfigNode::Double(const std::string& key, double fallback, double lo, do
   return v;
 }
 
+double ConfigNode::Positive(const std::string& key, double fallback) const {
+  const double v = Double(key, fallback);
+  if (Has(key) && !(v > 0.0)) {
+    std::ostringstream m;
+    m << "must be > 0, got " << v;
+    Fail(key, m.str());
+  }
+  return v;
+}
+
+double ConfigNode::NonNegative(const std::string& key, double fallback) const {
+  const double v = Double(key, fallback);
+  if (Has(key) && !(v >= 0.0)) {
+    std::ostringstream m;
+    m << "must be >= 0, got " << v;
+    Fail(key, m.str());
+  }
+  return v;
+}
+
 double ConfigNode::RequiredDouble(const std::string& key) const {
   if (!Has(key)) Fail(key, "required");
   return Double(key, 0.0);

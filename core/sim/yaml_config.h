@@ -31,6 +31,10 @@ class ConfigNode {
   double Double(const std::string& key, double fallback) const;
   /// Like Double, and throws unless lo <= value <= hi.
   double Double(const std::string& key, double fallback, double lo, double hi) const;
+  /// A standard deviation or another scale: finite and > 0 ("must be > 0, got X").
+  double Positive(const std::string& key, double fallback) const;
+  /// A noise density or bias size where 0 means none: finite and >= 0.
+  double NonNegative(const std::string& key, double fallback) const;
   double RequiredDouble(const std::string& key) const;
   int Int(const std::string& key, int fallback, int lo, int hi) const;
   bool Bool(const std::string& key, bool fallback) const;

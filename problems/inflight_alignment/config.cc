@@ -15,39 +15,18 @@ namespace {
 
 using sim::ConfigNode;
 
-/// A value for messages, in the shortest form (%g).
-std::string Number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-/// A standard deviation or another scale that must be positive: finite and > 0.
-double Positive(const ConfigNode& n, const std::string& key, double fallback) {
-  const double v = n.Double(key, fallback);
-  if (n.Has(key) && !(v > 0.0)) n.Fail(key, "must be > 0, got " + Number(v));
-  return v;
-}
-
-/// A bias size, a noise density or another value where 0 means "none": finite and >= 0.
-double NonNegative(const ConfigNode& n, const std::string& key, double fallback) {
-  const double v = n.Double(key, fallback);
-  if (n.Has(key) && !(v >= 0.0)) n.Fail(key, "must be >= 0, got " + Number(v));
-  return v;
-}
-
 InflightSensorSpec ParseSensors(const ConfigNode& n) {
   n.RequireKeys({"gyro_bias_deg_h", "gyro_arw_deg_sqrt_h", "accel_bias_ug", "accel_vrw_m_s_sqrt_h",
                  "gps_sigma_m"});
   InflightSensorSpec s;
   // Biases and noise densities may be zero (a sensor without that error); the filter's
   // process noise and the Schuler priors then leave the term out.
-  s.gyro_bias_deg_h = NonNegative(n, "gyro_bias_deg_h", s.gyro_bias_deg_h);
-  s.gyro_arw_deg_sqrt_h = NonNegative(n, "gyro_arw_deg_sqrt_h", s.gyro_arw_deg_sqrt_h);
-  s.accel_bias_ug = NonNegative(n, "accel_bias_ug", s.accel_bias_ug);
-  s.accel_vrw_m_s_sqrt_h = NonNegative(n, "accel_vrw_m_s_sqrt_h", s.accel_vrw_m_s_sqrt_h);
+  s.gyro_bias_deg_h = n.NonNegative("gyro_bias_deg_h", s.gyro_bias_deg_h);
+  s.gyro_arw_deg_sqrt_h = n.NonNegative("gyro_arw_deg_sqrt_h", s.gyro_arw_deg_sqrt_h);
+  s.accel_bias_ug = n.NonNegative("accel_bias_ug", s.accel_bias_ug);
+  s.accel_vrw_m_s_sqrt_h = n.NonNegative("accel_vrw_m_s_sqrt_h", s.accel_vrw_m_s_sqrt_h);
   // 0 asks for the estimate from the data (EstimateGpsSigma).
-  s.gps_sigma_m = NonNegative(n, "gps_sigma_m", s.gps_sigma_m);
+  s.gps_sigma_m = n.NonNegative("gps_sigma_m", s.gps_sigma_m);
   return s;
 }
 
@@ -55,17 +34,17 @@ InflightInitialSigma ParseInitial(const ConfigNode& n) {
   n.RequireKeys({"position_m", "velocity_mps", "level_arcmin", "heading_arcmin"});
   InflightInitialSigma s;
   // The filter's initial covariance: every diagonal entry must be positive.
-  s.position_m = Positive(n, "position_m", s.position_m);
-  s.velocity_mps = Positive(n, "velocity_mps", s.velocity_mps);
-  s.level_arcmin = Positive(n, "level_arcmin", s.level_arcmin);
-  s.heading_arcmin = Positive(n, "heading_arcmin", s.heading_arcmin);
+  s.position_m = n.Positive("position_m", s.position_m);
+  s.velocity_mps = n.Positive("velocity_mps", s.velocity_mps);
+  s.level_arcmin = n.Positive("level_arcmin", s.level_arcmin);
+  s.heading_arcmin = n.Positive("heading_arcmin", s.heading_arcmin);
   return s;
 }
 
 BaroLoopOptions ParseBaro(const ConfigNode& n) {
   n.RequireKeys({"time_constant_s"});
   BaroLoopOptions b;
-  b.time_constant_s = Positive(n, "time_constant_s", b.time_constant_s);
+  b.time_constant_s = n.Positive("time_constant_s", b.time_constant_s);
   return b;
 }
 
@@ -77,11 +56,11 @@ GpsSmootherOptions ParseSmoother(const ConfigNode& n) {
                  "initial_speed_sigma_mps", "noise_window_fixes", "noise_min_fixes", "min_position_sigma_m",
                  "max_position_sigma_m", "gate_probability", "reset_after_rejections"});
   GpsSmootherOptions o;
-  o.quiet_accel_noise_mps2_sqrt_hz = Positive(n, "quiet_accel_noise_mps2_sqrt_hz", o.quiet_accel_noise_mps2_sqrt_hz);
+  o.quiet_accel_noise_mps2_sqrt_hz = n.Positive("quiet_accel_noise_mps2_sqrt_hz", o.quiet_accel_noise_mps2_sqrt_hz);
   o.maneuver_accel_noise_mps2_sqrt_hz =
-      Positive(n, "maneuver_accel_noise_mps2_sqrt_hz", o.maneuver_accel_noise_mps2_sqrt_hz);
-  o.maneuver_mean_interval_s = Positive(n, "maneuver_mean_interval_s", o.maneuver_mean_interval_s);
-  o.maneuver_mean_duration_s = Positive(n, "maneuver_mean_duration_s", o.maneuver_mean_duration_s);
+      n.Positive("maneuver_accel_noise_mps2_sqrt_hz", o.maneuver_accel_noise_mps2_sqrt_hz);
+  o.maneuver_mean_interval_s = n.Positive("maneuver_mean_interval_s", o.maneuver_mean_interval_s);
+  o.maneuver_mean_duration_s = n.Positive("maneuver_mean_duration_s", o.maneuver_mean_duration_s);
   const std::string sigma_key = "initial_position_sigma_ned_m";
   if (n.Has(sigma_key)) {
     // One value for every axis, or [n, e, d].
@@ -94,7 +73,7 @@ GpsSmootherOptions ParseSmoother(const ConfigNode& n) {
       n.Fail(sigma_key, "every entry must be > 0 (standard deviations, m)");
     }
   }
-  o.initial_speed_sigma_mps = Positive(n, "initial_speed_sigma_mps", o.initial_speed_sigma_mps);
+  o.initial_speed_sigma_mps = n.Positive("initial_speed_sigma_mps", o.initial_speed_sigma_mps);
   constexpr int kMaxFixes = 1000000;
   o.noise_window_fixes = n.Int("noise_window_fixes", o.noise_window_fixes, 1, kMaxFixes);
   o.noise_min_fixes = n.Int("noise_min_fixes", o.noise_min_fixes, 1, kMaxFixes);
@@ -103,8 +82,8 @@ GpsSmootherOptions ParseSmoother(const ConfigNode& n) {
            "noise_min_fixes (" + std::to_string(o.noise_min_fixes) + ") must not exceed noise_window_fixes (" +
                std::to_string(o.noise_window_fixes) + ")");
   }
-  o.min_position_sigma_m = Positive(n, "min_position_sigma_m", o.min_position_sigma_m);
-  o.max_position_sigma_m = Positive(n, "max_position_sigma_m", o.max_position_sigma_m);
+  o.min_position_sigma_m = n.Positive("min_position_sigma_m", o.min_position_sigma_m);
+  o.max_position_sigma_m = n.Positive("max_position_sigma_m", o.max_position_sigma_m);
   if (o.max_position_sigma_m < o.min_position_sigma_m) {
     n.Fail(n.Has("max_position_sigma_m") ? "max_position_sigma_m" : "min_position_sigma_m",
            "max_position_sigma_m must be >= min_position_sigma_m");
@@ -120,8 +99,8 @@ GpsSmootherOptions ParseSmoother(const ConfigNode& n) {
 DistanceMethodOptions ParseDistance(const ConfigNode& n) {
   n.RequireKeys({"threshold_km", "recompute_every_km"});
   DistanceMethodOptions d;
-  d.threshold_km = Positive(n, "threshold_km", d.threshold_km);
-  d.recompute_every_km = NonNegative(n, "recompute_every_km", d.recompute_every_km);  // 0: once
+  d.threshold_km = n.Positive("threshold_km", d.threshold_km);
+  d.recompute_every_km = n.NonNegative("recompute_every_km", d.recompute_every_km);  // 0: once
   return d;
 }
 
@@ -138,9 +117,9 @@ BatchOptions ParseBatch(const ConfigNode& n) {
   } else {
     n.Fail("loss", "expected none, huber or cauchy, got '" + loss + "'");
   }
-  b.loss_scale_sigma = Positive(n, "loss_scale_sigma", b.loss_scale_sigma);
+  b.loss_scale_sigma = n.Positive("loss_scale_sigma", b.loss_scale_sigma);
   b.max_iterations = n.Int("max_iterations", b.max_iterations, 1, 100000);
-  b.tilt_segment_s = NonNegative(n, "tilt_segment_s", b.tilt_segment_s);  // 0: no level random walk
+  b.tilt_segment_s = n.NonNegative("tilt_segment_s", b.tilt_segment_s);  // 0: no level random walk
   return b;
 }
 

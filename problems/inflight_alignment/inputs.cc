@@ -1,10 +1,7 @@
 #include "problems/inflight_alignment/inputs.h"
 
-#include <stdlib.h>
-
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -127,25 +124,15 @@ InflightInputs LoadInflightInputs(const InflightFiles& files) {
 
 InflightInputs SimulateInflightInputs(const sim::Scenario& scenario, std::uint64_t seed) {
   if (!scenario.gnss) throw std::invalid_argument("scenario " + scenario.name + " has no GNSS");
-  std::string dir = (std::filesystem::temp_directory_path() / "navtwin_inflight_XXXXXX").string();
-  if (::mkdtemp(dir.data()) == nullptr) throw std::runtime_error("cannot create a temporary folder in " +
-                                                                 std::filesystem::temp_directory_path().string());
-  struct RemoveDir {
-    std::string path;
-    ~RemoveDir() {
-      std::error_code ec;
-      std::filesystem::remove_all(path, ec);
-    }
-  } remove{dir};
   sim::SimulationOptions options;
   options.seed = seed;
-  sim::Simulate(scenario, options, dir);
+  const sim::TemporarySimulation simulated(scenario, options, "navtwin_inflight_");
   InflightFiles files;
-  files.imu = dir + "/imu.txt";
-  files.gnss = dir + "/gnss.txt";
-  if (scenario.baro) files.baro = dir + "/baro.csv";
-  files.init = dir + "/init.nav";
-  files.truth = dir + "/truth.nav";
+  files.imu = simulated.path("imu.txt");
+  files.gnss = simulated.path("gnss.txt");
+  if (scenario.baro) files.baro = simulated.path("baro.csv");
+  files.init = simulated.path("init.nav");
+  files.truth = simulated.path("truth.nav");
   InflightInputs in = LoadInflightInputs(files);
   in.imu_path = "simulated " + scenario.name + " imu.txt";
   in.gnss_path = "simulated " + scenario.name + " gnss.txt";

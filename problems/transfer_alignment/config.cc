@@ -16,27 +16,6 @@ namespace {
 
 using sim::ConfigNode;
 
-std::string Number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-/// A standard deviation or another scale that must be positive: finite and > 0 (the
-/// filter's initial covariance and the measurement weights divide by it).
-double Positive(const ConfigNode& n, const std::string& key, double fallback) {
-  const double v = n.Double(key, fallback);
-  if (n.Has(key) && !(v > 0.0 && std::isfinite(v))) n.Fail(key, "must be > 0, got " + Number(v));
-  return v;
-}
-
-/// A noise density or bias size where 0 means "none": finite and >= 0.
-double NonNegative(const ConfigNode& n, const std::string& key, double fallback) {
-  const double v = n.Double(key, fallback);
-  if (n.Has(key) && !(v >= 0.0 && std::isfinite(v))) n.Fail(key, "must be >= 0, got " + Number(v));
-  return v;
-}
-
 TransferConfig ParseRoot(const ConfigNode& n) {
   n.RequireKeys({"gyro_bias_deg_h", "gyro_arw_deg_sqrt_h", "accel_bias_ug", "accel_vrw_m_s_sqrt_h",
                  "initial_velocity_mps", "initial_attitude_deg", "misalignment_deg", "delay_s", "delay_initial_s",
@@ -44,26 +23,26 @@ TransferConfig ParseRoot(const ConfigNode& n) {
                  "batch_state_interval_s", "batch_max_iterations"});
   TransferConfig c;
   // Slave sensor: biases and noise densities may be 0 (a sensor without that error).
-  c.gyro_bias_deg_h = NonNegative(n, "gyro_bias_deg_h", c.gyro_bias_deg_h);
-  c.gyro_arw_deg_sqrt_h = NonNegative(n, "gyro_arw_deg_sqrt_h", c.gyro_arw_deg_sqrt_h);
-  c.accel_bias_ug = NonNegative(n, "accel_bias_ug", c.accel_bias_ug);
-  c.accel_vrw_m_s_sqrt_h = NonNegative(n, "accel_vrw_m_s_sqrt_h", c.accel_vrw_m_s_sqrt_h);
+  c.gyro_bias_deg_h = n.NonNegative("gyro_bias_deg_h", c.gyro_bias_deg_h);
+  c.gyro_arw_deg_sqrt_h = n.NonNegative("gyro_arw_deg_sqrt_h", c.gyro_arw_deg_sqrt_h);
+  c.accel_bias_ug = n.NonNegative("accel_bias_ug", c.accel_bias_ug);
+  c.accel_vrw_m_s_sqrt_h = n.NonNegative("accel_vrw_m_s_sqrt_h", c.accel_vrw_m_s_sqrt_h);
   // Initial standard deviations: diagonal entries of P0, so > 0.
-  c.initial_velocity_mps = Positive(n, "initial_velocity_mps", c.initial_velocity_mps);
-  c.initial_attitude_deg = Positive(n, "initial_attitude_deg", c.initial_attitude_deg);
-  c.misalignment_deg = Positive(n, "misalignment_deg", c.misalignment_deg);
-  c.delay_s = Positive(n, "delay_s", c.delay_s);
+  c.initial_velocity_mps = n.Positive("initial_velocity_mps", c.initial_velocity_mps);
+  c.initial_attitude_deg = n.Positive("initial_attitude_deg", c.initial_attitude_deg);
+  c.misalignment_deg = n.Positive("misalignment_deg", c.misalignment_deg);
+  c.delay_s = n.Positive("delay_s", c.delay_s);
   // The delay's initial guess: a time shift, any finite value (the reader checks finiteness).
   c.delay_initial_s = n.Double("delay_initial_s", c.delay_initial_s);
   if (!std::isfinite(c.delay_initial_s)) n.Fail("delay_initial_s", "must be finite");
   // Master measurement noise: the R matrix of the filter and the batch's whitening, so > 0.
-  c.master_attitude_mrad = Positive(n, "master_attitude_mrad", c.master_attitude_mrad);
-  c.master_velocity_mps = Positive(n, "master_velocity_mps", c.master_velocity_mps);
-  c.master_fit_window_s = NonNegative(n, "master_fit_window_s", c.master_fit_window_s);
+  c.master_attitude_mrad = n.Positive("master_attitude_mrad", c.master_attitude_mrad);
+  c.master_velocity_mps = n.Positive("master_velocity_mps", c.master_velocity_mps);
+  c.master_fit_window_s = n.NonNegative("master_fit_window_s", c.master_fit_window_s);
   c.lever_arm_b_m = n.Vector("lever_arm_b_m", c.lever_arm_b_m);
   if (!c.lever_arm_b_m.allFinite()) n.Fail("lever_arm_b_m", "must be finite");
-  c.settle_s = NonNegative(n, "settle_s", c.settle_s);
-  c.batch_state_interval_s = Positive(n, "batch_state_interval_s", c.batch_state_interval_s);
+  c.settle_s = n.NonNegative("settle_s", c.settle_s);
+  c.batch_state_interval_s = n.Positive("batch_state_interval_s", c.batch_state_interval_s);
   c.batch_max_iterations = n.Int("batch_max_iterations", c.batch_max_iterations, 1, 100000);
   return c;
 }

@@ -8,11 +8,8 @@
 // the transpose), hence R_b_s_true = DcmFromEuler(r, p, y).
 #include "problems/transfer_alignment/inputs.h"
 
-#include <stdlib.h>
-
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 #include <string>
 
@@ -153,25 +150,15 @@ TransferInputs SimulateTransferInputs(const sim::Scenario& scenario, std::uint64
       throw std::invalid_argument("the transfer delay must be finite and >= 0 s");
     s.master->transfer_delay_s = *delay_override_s;
   }
-  std::string dir = (std::filesystem::temp_directory_path() / "navtwin_transfer_XXXXXX").string();
-  if (::mkdtemp(dir.data()) == nullptr)
-    throw std::runtime_error("cannot create a temporary folder in " + std::filesystem::temp_directory_path().string());
-  struct RemoveDir {
-    std::string path;
-    ~RemoveDir() {
-      std::error_code ec;
-      std::filesystem::remove_all(path, ec);
-    }
-  } remove{dir};
   sim::SimulationOptions options;
   options.seed = seed;
-  sim::Simulate(s, options, dir);
+  const sim::TemporarySimulation simulated(s, options, "navtwin_transfer_");
 
   TransferFiles files;
-  files.slave_imu = dir + "/imu.txt";
-  files.master = dir + "/master.nav";
-  files.init = dir + "/init.nav";  // one record at the start: truth + init_errors (body attitude)
-  files.truth = dir + "/truth.nav";
+  files.slave_imu = simulated.path("imu.txt");
+  files.master = simulated.path("master.nav");
+  files.init = simulated.path("init.nav");  // one record at the start: truth + init_errors (body attitude)
+  files.truth = simulated.path("truth.nav");
   TransferInputs in = LoadTransferInputs(files);
   const Eigen::Vector3d& rpy = s.imu.mounting_rpy_rad;
   in.true_misalignment = Eigen::Quaterniond(DcmFromEuler(rpy.x(), rpy.y(), rpy.z())).normalized();
