@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -80,10 +82,15 @@ TEST(MonteCarloRunnerTest, WorkerCountIsClampedToTheRuns) {
 
 TEST(MonteCarloRunnerTest, AnExceptionInARunStopsTheRunsAndIsRethrown) {
   std::atomic<int> executed{0};
+  // Every run but the failing one takes 20 us, so that all 100000 would take 2 s on the
+  // other worker: the worker that draws run 10 throws after at most a few runs even when
+  // it is descheduled for a while (with empty runs, the other worker could finish all of
+  // them in a millisecond before run 10 even starts, which made this test flaky).
   EXPECT_THROW(RunParallel(100000, 2,
                            [&](int run, int) {
                              ++executed;
                              if (run == 10) throw std::runtime_error("run 10 failed");
+                             std::this_thread::sleep_for(std::chrono::microseconds(20));
                            }),
                std::runtime_error);
   // The workers stop taking runs once run 10 fails: far fewer than all were executed
