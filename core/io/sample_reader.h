@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/types.h"
 
@@ -19,6 +20,16 @@ class SampleReader {
   /// The file being read (for messages).
   virtual const std::string& path() const = 0;
 };
+
+/// Every remaining sample of a reader, in order (the reader's checks apply): for records
+/// that fit in memory.
+template <typename Sample>
+std::vector<Sample> ReadAll(SampleReader<Sample>& reader) {
+  std::vector<Sample> out;
+  Sample s;
+  while (reader.Next(&s)) out.push_back(s);
+  return out;
+}
 
 using ImuReader = SampleReader<ImuSample>;
 using GnssReader = SampleReader<GnssSample>;

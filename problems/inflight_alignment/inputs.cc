@@ -13,14 +13,6 @@
 namespace navtwin::inflight {
 namespace {
 
-template <typename Sample, typename Reader>
-std::vector<Sample> ReadAll(Reader& reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader.Next(&s)) out.push_back(s);
-  return out;
-}
-
 std::string Name(const std::string& path, const char* fallback) { return path.empty() ? fallback : path; }
 
 // Samples are counted from 1 in messages ("sample N" stands where a text file has a line).

@@ -224,14 +224,6 @@ std::string Fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
   return buf;
 }
 
-template <typename Sample, typename Reader>
-std::vector<Sample> ReadAll(Reader& reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader.Next(&s)) out.push_back(s);
-  return out;
-}
-
 struct OffsetSearch {
   double offset_s = 0.0;
   double correlation = 0.0;

@@ -21,14 +21,6 @@
 namespace navtwin::transfer {
 namespace {
 
-template <typename Sample, typename Reader>
-std::vector<Sample> ReadAll(Reader& reader) {
-  std::vector<Sample> out;
-  Sample s;
-  while (reader.Next(&s)) out.push_back(s);
-  return out;
-}
-
 std::string Name(const std::string& path, const char* fallback) { return path.empty() ? fallback : path; }
 
 // Samples and records are counted from 1 in messages ("sample N" where a text file has a line:
