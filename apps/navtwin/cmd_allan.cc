@@ -11,6 +11,7 @@
 
 #include "apps/navtwin/command.h"
 #include "core/allan.h"
+#include "core/calibration_file.h"
 #include "core/io/atomic_file.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
@@ -19,6 +20,8 @@
 
 DECLARE_string(format);
 DECLARE_string(out);
+DECLARE_string(calibration);          // cmd_ins.cc
+DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DEFINE_string(axis, "all", "allan: axis to analyse: gx, gy, gz (gyros), ax, ay, az (accelerometers) or all");
 
 namespace navtwin::app {
@@ -61,7 +64,7 @@ struct Record {
 };
 
 Record ReadRecord(const std::string& path, const std::vector<Axis>& axes) {
-  auto reader = OpenImu(path);
+  auto reader = OpenImu(path, FLAGS_calibration, FLAGS_imu_temperature_degC);
   Record r;
   r.increments.resize(axes.size());
   std::vector<double> dts;
@@ -211,6 +214,9 @@ int RunAllan(const std::vector<std::string>& args) {
     if (FLAGS_axis == "all" || FLAGS_axis == a.name) axes.push_back(a);
   }
   if (axes.empty()) return Usage("--axis must be gx, gy, gz, ax, ay, az or all");
+  if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
+    return Usage("--imu_temperature_degC goes with --calibration");
+  }
   const Record record = ReadRecord(args[0], axes);
   const std::vector<AxisResult> results = Analyse(record, axes);
   if (!FLAGS_out.empty()) WriteCsv(FLAGS_out, results);
@@ -226,8 +232,9 @@ int RunAllan(const std::vector<std::string>& args) {
 
 Command AllanCommand() {
   return {"allan", "Allan deviation of IMU axes with ARW, bias instability and rate random walk",
-          "navtwin allan FILE [--axis gx|gy|gz|ax|ay|az|all] [--out CSV] [--format=json]",
-          {"axis", "out"},
+          "navtwin allan FILE [--axis gx|gy|gz|ax|ay|az|all] [--out CSV] "
+          "[--calibration FILE [--imu_temperature_degC T]] [--format=json]",
+          {"axis", "out", "calibration", "imu_temperature_degC"},
           &RunAllan};
 }
 

@@ -27,6 +27,8 @@
 
 DECLARE_string(format);
 DECLARE_string(imu);        // cmd_ins.cc
+DECLARE_string(calibration);          // cmd_ins.cc
+DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DECLARE_string(truth);      // cmd_ins.cc
 DECLARE_string(init_from);  // cmd_ins.cc
 DECLARE_double(start_s);    // cmd_ins.cc (NaN: the first record of --init_from)
@@ -112,7 +114,7 @@ std::string OutlierText(const sim::Scenario& s) {
 
 const char* kAlignUsage =
     "navtwin inflight-align --imu F --gnss F [--baro F] --init_from NAV [--start_s T] [--truth NAV] "
-    "[--config YAML] --method distance|kalman|batch|all [--track_csv F] [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method distance|kalman|batch|all [--track_csv F] [--format=json]\n"
     "       navtwin inflight-align --scenario PRESET|YAML [--seed S] [--outlier_fraction P --outlier_m M] "
     "[--config YAML] --method distance|kalman|batch|all [--track_csv F] [--format=json]\n"
     "  The initial state is the record of --init_from at or after --start_s (default its first record);\n"
@@ -143,7 +145,7 @@ int RunInflightAlign(const std::vector<std::string>& args) {
   }
   const bool scenario = !FLAGS_scenario.empty();
   if (scenario) {
-    for (const char* flag : {"imu", "gnss", "baro", "init_from", "start_s", "truth"}) {
+    for (const char* flag : {"imu", "gnss", "baro", "init_from", "start_s", "truth", "calibration", "imu_temperature_degC"}) {
       if (!IsDefault(flag)) return usage(std::string("--scenario simulates its own files: drop --") + flag);
     }
   } else {
@@ -151,6 +153,9 @@ int RunInflightAlign(const std::vector<std::string>& args) {
     if (FLAGS_init_from.empty()) return usage("--init_from NAV is required: the INS's initial state");
     if (!IsDefault("seed")) return usage("--seed goes with --scenario");
     if (!std::isnan(FLAGS_start_s) && !std::isfinite(FLAGS_start_s)) return usage("--start_s must be a time, s");
+    if (FLAGS_calibration.empty() && !IsDefault("imu_temperature_degC")) {
+      return usage("--imu_temperature_degC goes with --calibration");
+    }
   }
   const std::string outlier_error = CheckOutlierFlags(scenario);
   if (!outlier_error.empty()) return usage(outlier_error);
@@ -170,6 +175,8 @@ int RunInflightAlign(const std::vector<std::string>& args) {
     files.init = FLAGS_init_from;
     files.init_time_s = std::isnan(FLAGS_start_s) ? -1.0 : FLAGS_start_s;
     files.truth = FLAGS_truth;
+    files.calibration = FLAGS_calibration;
+    files.imu_temperature_degC = FLAGS_imu_temperature_degC;
     inputs = inflight::LoadInflightInputs(files);
   }
   if (inputs.truth.empty()) std::cerr << "inflight-align: no --truth: heading errors are not known (printed as -)\n";
@@ -437,7 +444,7 @@ Command InflightAlignCommand() {
           "In-flight heading alignment from the distance flown (seed 003): distance, kalman or batch",
           kAlignUsage,
           {"imu", "gnss", "baro", "init_from", "start_s", "truth", "config", "scenario", "seed", "method",
-           "track_csv", "outlier_fraction", "outlier_m"},
+           "track_csv", "outlier_fraction", "outlier_m", "calibration", "imu_temperature_degC"},
           &RunInflightAlign};
 }
 

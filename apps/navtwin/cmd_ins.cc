@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "apps/navtwin/command.h"
+#include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
@@ -21,6 +22,12 @@
 
 DECLARE_string(format);
 DEFINE_string(imu, "", "IMU file (any format `navtwin info` knows)");
+DEFINE_string(calibration, "",
+              "Calibration file (docs/calibration-file.md) applied as the IMU (its imu section) and the "
+              "magnetometer (its mag section) are read");
+DEFINE_double(imu_temperature_degC, NAN,
+              "IMU temperature at which the calibration's temperature terms are evaluated, degC "
+              "(default: the calibration file's reference temperature)");
 DEFINE_string(out, "", "ins: output folder (created if missing) for nav.nav; convert: output file");
 DEFINE_string(truth, "", "Reference trajectory (navigation file) to compute errors against");
 DEFINE_string(init_from, "", "Navigation file whose record at --start_s sets the initial state");
@@ -154,6 +161,9 @@ int RunIns(const std::vector<std::string>& args) {
     }
   }
   if (FLAGS_output_rate_hz < 0.0) return Usage("--output_rate_hz must be >= 0");
+  if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
+    return Usage("--imu_temperature_degC goes with --calibration");
+  }
   if (!MakeDir(FLAGS_out)) return Usage("cannot create the output folder " + FLAGS_out);
 
   std::string imu_path = FLAGS_imu, truth_path = FLAGS_truth, init_path = FLAGS_init_from;
@@ -179,7 +189,7 @@ int RunIns(const std::vector<std::string>& args) {
   options.end_time_s = FLAGS_end_s;
   options.progress_every = 200000;
 
-  auto imu = OpenImu(imu_path);
+  auto imu = OpenImu(imu_path, FLAGS_calibration, FLAGS_imu_temperature_degC);
   std::unique_ptr<NavReader> truth;
   if (!truth_path.empty()) truth = OpenNav(truth_path);
   const std::string nav_path = FLAGS_out + "/nav.nav";
@@ -205,11 +215,11 @@ Command InsCommand() {
           "Pure inertial navigation (strapdown) over an IMU record; errors against a truth file",
           "navtwin ins --imu F (--init_from NAVFILE | --init_lat_deg D --init_lon_deg D "
           "--init_yaw_deg D [--init_h_m ...]) --out DIR [--truth F] [--output_rate_hz R] "
-          "[--format=json]\n       navtwin ins --demo --out DIR",
+          "[--calibration FILE [--imu_temperature_degC T]] [--format=json]\n       navtwin ins --demo --out DIR",
           {"imu", "out", "truth", "init_from", "init_lat_deg", "init_lon_deg", "init_h_m",
            "init_vn_mps", "init_ve_mps", "init_vd_mps", "init_roll_deg", "init_pitch_deg",
            "init_yaw_deg", "start_s", "end_s", "output_rate_hz", "hold_height_m", "demo",
-           "demo_rate_hz", "demo_duration_s"},
+           "demo_rate_hz", "demo_duration_s", "calibration", "imu_temperature_degC"},
           &RunIns};
 }
 

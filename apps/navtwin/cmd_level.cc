@@ -21,6 +21,8 @@
 DECLARE_string(format);
 DECLARE_string(imu);
 DECLARE_double(start_s);
+DECLARE_string(calibration);          // cmd_ins.cc
+DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DEFINE_double(window_s, 0.2, "level, level-mc: leveling window length, s");
 DEFINE_double(noise_mg, 50.0,
               "Accelerometer white noise, 1 sigma per axis, mg (level-mc: simulated; level: assumed by the "
@@ -149,8 +151,12 @@ int RunLevel(const std::vector<std::string>& args) {
   leveling::LevelingOptions options;
   const std::string bad = OptionsFromFlags(&options);
   if (!bad.empty()) return Usage(bad);
+  if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
+    return Usage("--imu_temperature_degC goes with --calibration");
+  }
 
-  const leveling::AccelWindow window = leveling::ReadAccelWindow(FLAGS_imu, start_s, FLAGS_window_s);
+  const leveling::AccelWindow window = leveling::ReadAccelWindow(FLAGS_imu, start_s, FLAGS_window_s,
+                                                                 FLAGS_calibration, FLAGS_imu_temperature_degC);
   const leveling::WindowCheck check = leveling::CheckWindow(window, options);
   if (check.moving && !FLAGS_allow_motion) {
     Report(check.message, "error");
@@ -177,7 +183,7 @@ int RunLevel(const std::vector<std::string>& args) {
 Command LevelCommand() {
   return {"level", "Roll and pitch from a window of a recorded IMU file by every leveling method",
           "navtwin level --imu FILE [--start_s S] [--window_s W] [--noise_mg N] [--vib_axes xyz] "
-          "[--vib_tones K] [--allow_motion] [--format=json]\n"
+          "[--vib_tones K] [--allow_motion] [--calibration FILE [--imu_temperature_degC T]] [--format=json]\n"
           "  --start_s counts from the first IMU sample (default 0), --window_s defaults to 0.2 s; without\n"
           "  --noise_mg the white noise is estimated from the data; without --vib_axes the batch models\n"
           "  vibration on all three axes. Methods: plain_mean, period_average, filter, batch.\n"
@@ -190,7 +196,8 @@ Command LevelCommand() {
           "  - a moving vehicle (mean angular rate > 0.05 rad/s, or mean |f| more than 0.5 m/s^2 from g):\n"
           "    the reason on stderr and exit 1, unless --allow_motion;\n"
           "  - a window beyond the end of the record or with fewer than 8 samples: exit 1.",
-          {"imu", "start_s", "window_s", "noise_mg", "vib_axes", "vib_tones", "allow_motion"},
+          {"imu", "start_s", "window_s", "noise_mg", "vib_axes", "vib_tones", "allow_motion", "calibration",
+           "imu_temperature_degC"},
           &RunLevel};
 }
 

@@ -43,6 +43,8 @@
 
 DECLARE_string(format);
 DECLARE_string(imu);
+DECLARE_string(calibration);          // cmd_ins.cc
+DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DECLARE_string(out);
 DECLARE_string(truth);
 DECLARE_double(output_rate_hz);
@@ -348,6 +350,9 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
     return usage("--smoother must be rts (or absent)");
   }
   if (FLAGS_output_rate_hz < 0.0) return usage("--output_rate_hz must be >= 0");
+  if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
+    return usage("--imu_temperature_degC goes with --calibration");
+  }
   const bool outage_flags = FlagSet("outage_start_s") || FlagSet("outage_len_s") || FlagSet("outage_period_s");
   if (outage_flags) {
     if (std::isnan(FLAGS_outage_start_s) || !(FLAGS_outage_len_s > 0.0) || FLAGS_outage_start_s < 0.0) {
@@ -417,7 +422,8 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
   std::cerr << opt.command << ": reading " << files.imu << ", " << files.gnss
             << (files.mag.empty() ? "" : ", " + files.mag) << (files.baro.empty() ? "" : ", " + files.baro)
             << "\n";
-  gnss_ins::InputPaths paths{files.imu, files.gnss, files.mag, files.baro};
+  gnss_ins::InputPaths paths{files.imu, files.gnss, files.mag, files.baro, FLAGS_calibration,
+                             FLAGS_imu_temperature_degC};
   const Inputs inputs = gnss_ins::LoadInputs(paths, config);
   if (config.init.state && std::isnan(config.init.state->nav.t_s)) {
     // A given initial state without a time: the start of the first IMU interval.
@@ -500,11 +506,13 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
 const char* const kNavigateUsage =
     "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
-    "[--outage_period_s P]] [--start_s S] [--end_s S] [--format=json]";
+    "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
+    "[--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
-    "[--outage_period_s P]] [--start_s S] [--end_s S] [--format=json]\n"
+    "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
+    "[--format=json]\n"
     "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
 
 int RunNavigate(const std::vector<std::string>& args) { return Run({"navigate", kNavigateUsage}, args); }
@@ -517,7 +525,8 @@ Command NavigateCommand() {
           "GNSS/INS/magnetometer error-state Kalman filter (and RTS smoother) over a record",
           kNavigateUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "smoother", "truth",
-           "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s"},
+           "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
+           "calibration", "imu_temperature_degC"},
           &RunNavigate};
 }
 
@@ -527,7 +536,7 @@ Command SmoothCommand() {
           kSmoothUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "truth", "output_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
-           "demo_scenario", "demo_mag"},
+           "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC"},
           &RunSmooth};
 }
 

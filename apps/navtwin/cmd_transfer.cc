@@ -23,6 +23,8 @@
 
 DECLARE_string(format);     // main.cc
 DECLARE_string(truth);      // cmd_ins.cc
+DECLARE_string(calibration);          // cmd_ins.cc
+DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DECLARE_string(init_from);  // cmd_ins.cc
 DECLARE_double(start_s);    // cmd_ins.cc (NaN: the start of the slave IMU data)
 DECLARE_string(config);     // cmd_navigate.cc
@@ -43,7 +45,7 @@ using transfer::TransferResult;
 
 const char* kUsage =
     "navtwin transfer-align --master F --slave_imu F --init_from NAV [--start_s T] [--truth NAV] "
-    "[--config YAML] --method order1|order2|batch|all [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|batch|all [--format=json]\n"
     "       navtwin transfer-align --scenario PRESET|YAML [--seed S] [--delay_s X] [--config YAML] "
     "--method order1|order2|batch|all [--format=json]\n"
     "  The slave starts from the record of --init_from at or after --start_s (default: the start of the\n"
@@ -77,7 +79,7 @@ int RunTransferAlign(const std::vector<std::string>& args) {
   }
   const bool scenario = !FLAGS_scenario.empty();
   if (scenario) {
-    for (const char* flag : {"master", "slave_imu", "init_from", "start_s", "truth"}) {
+    for (const char* flag : {"master", "slave_imu", "init_from", "start_s", "truth", "calibration", "imu_temperature_degC"}) {
       if (!IsDefault(flag)) return Usage(std::string("--scenario simulates its own files: drop --") + flag);
     }
     if (!IsDefault("delay_s") && !(std::isfinite(FLAGS_delay_s) && FLAGS_delay_s >= 0.0)) {
@@ -89,6 +91,9 @@ int RunTransferAlign(const std::vector<std::string>& args) {
     if (!IsDefault("seed")) return Usage("--seed goes with --scenario");
     if (!IsDefault("delay_s")) return Usage("--delay_s goes with --scenario");
     if (!std::isnan(FLAGS_start_s) && !std::isfinite(FLAGS_start_s)) return Usage("--start_s must be a time, s");
+    if (FLAGS_calibration.empty() && !IsDefault("imu_temperature_degC")) {
+      return Usage("--imu_temperature_degC goes with --calibration");
+    }
   }
 
   const TransferConfig config = FLAGS_config.empty() ? TransferConfig() : transfer::LoadTransferConfig(FLAGS_config);
@@ -107,6 +112,8 @@ int RunTransferAlign(const std::vector<std::string>& args) {
     files.init = FLAGS_init_from;
     files.init_time_s = std::isnan(FLAGS_start_s) ? -1.0 : FLAGS_start_s;
     files.truth = FLAGS_truth;
+    files.calibration = FLAGS_calibration;
+    files.imu_temperature_degC = FLAGS_imu_temperature_degC;
     inputs = transfer::LoadTransferInputs(files);
   }
   if (inputs.truth.empty()) std::cerr << "transfer-align: no --truth: attitude errors are not known (printed as -)\n";
@@ -143,7 +150,8 @@ Command TransferAlignCommand() {
   return {"transfer-align",
           "Transfer alignment with misalignment and delay estimation (seed 002): order1, order2 or batch",
           kUsage,
-          {"master", "slave_imu", "init_from", "start_s", "truth", "config", "scenario", "seed", "delay_s", "method"},
+          {"master", "slave_imu", "init_from", "start_s", "truth", "config", "scenario", "seed", "delay_s", "method",
+           "calibration", "imu_temperature_degC"},
           &RunTransferAlign};
 }
 

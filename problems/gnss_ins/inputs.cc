@@ -8,6 +8,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
@@ -48,12 +49,13 @@ double IsaAltitude_m(double pressure_pa) {
   return 288.15 / 0.0065 * (1.0 - std::pow(pressure_pa / 101325.0, 1.0 / 5.255877));
 }
 
-std::vector<ImuSample> ReadImu(const std::string& path, const GnssInsConfig& config) {
+std::vector<ImuSample> ReadImu(const std::string& path, const std::string& calibration, double temperature_degC,
+                               const GnssInsConfig& config) {
   const Installation& inst = config.installation;
   const Eigen::Vector3d& rpy = inst.imu_mounting_rpy_rad;
   // v_b = R_b_imu v_imu (config.h, Installation).
   const Eigen::Matrix3d R_b_imu = DcmFromEuler(rpy[0], rpy[1], rpy[2]);
-  auto reader = OpenImu(path);
+  auto reader = OpenImu(path, calibration, temperature_degC);
   std::vector<ImuSample> out;
   ImuSample s;
   while (reader->Next(&s)) {
@@ -149,8 +151,9 @@ std::vector<GnssSample> ReadGnss(const std::string& path, double t_begin, double
   return out;
 }
 
-std::vector<MagSample> ReadMag(const std::string& path, double t_begin, double t_end) {
-  auto reader = OpenMag(path);
+std::vector<MagSample> ReadMag(const std::string& path, const std::string& calibration, double t_begin,
+                               double t_end) {
+  auto reader = OpenMag(path, calibration);
   std::vector<MagSample> out;
   MagSample m;
   while (reader->Next(&m)) {
@@ -189,9 +192,21 @@ std::vector<BaroSample> ReadBaro(const std::string& path, double t_begin, double
 Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
   if (paths.imu.empty()) throw InputError("(no file)", 0, "imu", "no IMU file given");
   if (paths.gnss.empty()) throw InputError("(no file)", 0, "gnss", "no GNSS file given");
+  // The calibration file's sections that apply (an empty path: none).
+  std::string imu_calibration, mag_calibration;
+  if (!paths.calibration.empty()) {
+    const CalibrationFile file = ReadCalibrationFile(paths.calibration);
+    if (file.imu) imu_calibration = paths.calibration;
+    if (file.mag && !paths.mag.empty()) mag_calibration = paths.calibration;
+    if (imu_calibration.empty() && mag_calibration.empty()) {
+      throw InputError(paths.calibration, 0, "imu",
+                       paths.mag.empty() ? "no imu section: the file does not calibrate the IMU"
+                                         : "neither an imu nor a mag section: nothing to calibrate");
+    }
+  }
   Inputs in;
   in.paths = paths;
-  in.imu = BridgeGaps(ReadImu(paths.imu, config), paths.imu, config.installation.imu_time_offset_s,
+  in.imu = BridgeGaps(ReadImu(paths.imu, imu_calibration, paths.imu_temperature_degC, config), paths.imu, config.installation.imu_time_offset_s,
                       config.filter.max_bridge_gap_s, &in.bridged_imu_gaps);
   const double t_begin = in.imu.front().t_s - in.imu.front().dt_s;
   const double t_end = in.imu.back().t_s;
@@ -232,7 +247,7 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
     }
   }
 
-  if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, t_begin, t_end);
+  if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, mag_calibration, t_begin, t_end);
   if (!paths.baro.empty()) in.baro = ReadBaro(paths.baro, t_begin, t_end);
   return in;
 }

@@ -3,6 +3,7 @@
 // on the GNSS time scale (time offset applied), with dt_s from the time tags.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,11 @@ namespace navtwin::gnss_ins {
 
 struct InputPaths {
   std::string imu, gnss, mag, baro;  ///< mag and baro may be empty
+  /// Calibration file (core/calibration_file.h) or empty: its imu section is applied to the
+  /// IMU (in the IMU's own axes, before the mounting), its mag section to the magnetometer;
+  /// it must hold at least one of the two for the files read.
+  std::string calibration;
+  double imu_temperature_degC = NAN;  ///< NaN: the calibration's reference temperature
 };
 
 struct Inputs {

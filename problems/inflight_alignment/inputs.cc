@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/sim/simulator.h"
@@ -90,7 +91,7 @@ InflightInputs LoadInflightInputs(const InflightFiles& files) {
   in.imu_path = files.imu;
   in.gnss_path = files.gnss;
   in.baro_path = files.baro;
-  in.imu = ReadAll<ImuSample>(*OpenImu(files.imu));
+  in.imu = ReadAll<ImuSample>(*OpenImu(files.imu, files.calibration, files.imu_temperature_degC));
   in.gnss = ReadAll<GnssSample>(*OpenGnss(files.gnss));
   if (!files.baro.empty()) in.baro = ReadAll<BaroSample>(*OpenBaro(files.baro));
   {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,10 @@ struct InflightFiles {
   std::string init;   ///< navigation file whose first record at or after init_time_s is the initial state
   double init_time_s = -1.0;  ///< < 0: the first record
   std::string truth;  ///< navigation file; may be empty
+  /// Calibration file (core/calibration_file.h) applied to the IMU, or empty; its
+  /// temperature terms at imu_temperature_degC (NaN: the file's reference temperature).
+  std::string calibration;
+  double imu_temperature_degC = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Reads the files with the core/io readers (any format they know) and validates.

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
@@ -153,7 +154,8 @@ AccelWindow WithoutMarked(const AccelWindow& w, const std::vector<bool>& marked)
 
 }  // namespace
 
-AccelWindow ReadAccelWindow(const std::string& path, double start_s, double window_s) {
+AccelWindow ReadAccelWindow(const std::string& path, double start_s, double window_s,
+                            const std::string& calibration_path, double temperature_degC) {
   if (!std::isfinite(start_s) || start_s < 0.0) {
     throw std::invalid_argument(Format("start_s must be a finite number >= 0 (s after the first IMU sample), got %g",
                                        start_s));
@@ -161,7 +163,7 @@ AccelWindow ReadAccelWindow(const std::string& path, double start_s, double wind
   if (!std::isfinite(window_s) || window_s <= 0.0) {
     throw std::invalid_argument(Format("window_s must be a finite number > 0, got %g", window_s));
   }
-  const std::unique_ptr<ImuReader> reader = OpenImu(path);
+  const std::unique_ptr<ImuReader> reader = OpenImu(path, calibration_path, temperature_degC);
   AccelWindow w;
   w.source = path;
   ImuSample s;

@@ -3,6 +3,7 @@
 // implemented beside it in window.cc. docs/leveling.md describes the checks.
 #pragma once
 
+#include <cmath>
 #include <string>
 
 #include "problems/leveling/leveling.h"
@@ -16,8 +17,11 @@ namespace navtwin::leveling {
 /// Throws std::invalid_argument for a negative or non-finite start_s or a non-positive
 /// window_s, and InputError (file, field "t_s") when the window goes beyond the end of
 /// the record (the message gives the record length) or holds fewer than 8 samples;
-/// the readers' own InputErrors pass through.
-AccelWindow ReadAccelWindow(const std::string& path, double start_s, double window_s);
+/// the readers' own InputErrors pass through. A non-empty calibration_path applies that
+/// calibration file's imu section at temperature_degC (core/calibration_file.h; NaN: the
+/// file's reference temperature).
+AccelWindow ReadAccelWindow(const std::string& path, double start_s, double window_s,
+                            const std::string& calibration_path = "", double temperature_degC = NAN);
 
 /// The fewest samples a window may hold (the autocorrelation needs some lags).
 constexpr int kMinWindowSamples = 8;

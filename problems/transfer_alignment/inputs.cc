@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
@@ -103,7 +104,7 @@ TransferInputs LoadTransferInputs(const TransferFiles& files) {
   TransferInputs in;
   in.slave_path = files.slave_imu;
   in.master_path = files.master;
-  in.slave_imu = ReadAll<ImuSample>(*OpenImu(files.slave_imu));
+  in.slave_imu = ReadAll<ImuSample>(*OpenImu(files.slave_imu, files.calibration, files.imu_temperature_degC));
   in.master = ReadAll<NavState>(*OpenNav(files.master));
   if (in.slave_imu.empty()) throw InputError(files.slave_imu, 0, "imu", "no IMU samples");
   {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,6 +44,10 @@ struct TransferFiles {
   std::string init;
   double init_time_s = -1.0;  ///< < 0: the start of the slave IMU data (first sample minus its dt)
   std::string truth;          ///< optional body truth (navigation file)
+  /// Calibration file (core/calibration_file.h) applied to the slave IMU, or empty; its
+  /// temperature terms at imu_temperature_degC (NaN: the file's reference temperature).
+  std::string calibration;
+  double imu_temperature_degC = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Reads the files with the core/io readers and validates (InputError: file, line, field).

@@ -56,7 +56,7 @@ TEST(RtklibWalk, HeadingSearchThenFilterRtsAndBatchBridgeOutages) {
   config.outages.start_s = 30.0;
   config.outages.len_s = 15.0;
   config.outages.period_s = 45.0;
-  const Inputs inputs = LoadInputs({imu, gnss, "", ""}, config);
+  const Inputs inputs = LoadInputs({imu, gnss, "", "", "", NAN}, config);
   ASSERT_EQ(inputs.outages.size(), 3u);  // 30-45, 75-90, 120-135 s of a 134 s record
 
   // The heading search (its table of scores goes to the test log). A sweep of given
