@@ -1,0 +1,156 @@
+// IMU calibration reports: parameter names, the JSON object of --format=json and the text
+// table for people (units in its header: ppm, mrad, mg, deg/h, deg/h/g).
+#include "problems/calibration/imu_calibration.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/io/csv_imu.h"
+#include "core/io/json_writer.h"
+
+namespace navtwin::calibration {
+namespace {
+
+const char* const kAxis[3] = {"x", "y", "z"};
+
+/// (row, col) of misalignment entry k = 0..5 of a triad block (index 3 + k).
+std::pair<int, int> MisalignmentRowCol(int k) {
+  const int row = k / 2;
+  const int j = k % 2;
+  const int col = j < row ? j : j + 1;  // inverse of MisalignmentIndex
+  return {row, col};
+}
+
+/// One row of a report: name, SI value and sigma, the factor to the printed unit and the unit.
+struct Row {
+  std::string name;
+  double value = 0.0;
+  double sigma = std::numeric_limits<double>::quiet_NaN();
+  double per_si = 1.0;
+  const char* unit = "";
+};
+
+constexpr double kRadPerSToDegPerH = 180.0 / M_PI * 3600.0;
+constexpr double kMps2ToMg = 1000.0 / kStandardGravity_mps2;
+
+double SigmaOr(const std::optional<Eigen::Matrix<double, kTriadParameters, 1>>& s, int i) {
+  return s ? (*s)(i) : std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<Row> Rows(const ImuCalibration& c) {
+  std::vector<Row> rows;
+  const auto triad = [&rows](const std::string& name, const Eigen::Matrix<double, kTriadParameters, 1>& v,
+                             const std::optional<Eigen::Matrix<double, kTriadParameters, 1>>& s,
+                             double bias_per_si, const char* bias_unit) {
+    for (int i = 0; i < kTriadParameters; ++i) {
+      Row r;
+      r.name = TriadParameterName(name, i);
+      r.value = v(i);
+      r.sigma = SigmaOr(s, i);
+      if (i < 3) {
+        r.per_si = 1e6;
+        r.unit = "ppm";
+      } else if (i < 9) {
+        r.per_si = 1e3;
+        r.unit = "mrad";
+      } else {
+        r.per_si = bias_per_si;
+        r.unit = bias_unit;
+      }
+      rows.push_back(r);
+    }
+  };
+  triad("accel", c.accel, c.accel_sigma, kMps2ToMg, "mg");
+  triad("gyro", c.gyro, c.gyro_sigma, kRadPerSToDegPerH, "deg/h");
+  for (int i = 0; i < kGSensitivityParameters; ++i) {
+    Row r;
+    r.name = GSensitivityParameterName(i);
+    r.value = c.g_sensitivity(i);
+    r.sigma = c.g_sensitivity_sigma ? (*c.g_sensitivity_sigma)(i) : std::numeric_limits<double>::quiet_NaN();
+    r.per_si = kRadPerSToDegPerH * kStandardGravity_mps2;
+    r.unit = "deg/h/g";
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::string TriadParameterName(const std::string& triad, int index) {
+  if (index < 0 || index >= kTriadParameters) {
+    throw std::out_of_range("TriadParameterName: index " + std::to_string(index) + " not in [0, 12)");
+  }
+  if (index < 3) return triad + ".scale_factor." + kAxis[index];
+  if (index < 9) {
+    const auto [row, col] = MisalignmentRowCol(index - 3);
+    return triad + ".misalignment." + kAxis[row] + kAxis[col];
+  }
+  return triad + ".bias." + kAxis[index - 9];
+}
+
+std::string GSensitivityParameterName(int index) {
+  if (index < 0 || index >= kGSensitivityParameters) {
+    throw std::out_of_range("GSensitivityParameterName: index " + std::to_string(index) + " not in [0, 9)");
+  }
+  return std::string("g_sensitivity.") + kAxis[index / 3] + kAxis[index % 3];
+}
+
+std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::string& rig) {
+  std::ostringstream out;
+  JsonWriter json(out);
+  json.BeginObject();
+  json.Field("rig", rig);
+  json.Key("parameters").BeginObject();
+  for (const Row& r : Rows(result.calibration)) {
+    json.Key(r.name).BeginObject();
+    json.Field("value", r.value);
+    json.Field("sigma", r.sigma);  // NaN (not estimated) is written as null
+    json.EndObject();
+  }
+  json.EndObject();
+  json.Key("unobservable").BeginArray();
+  for (const std::string& u : result.unobservable) json.Value(u);
+  json.EndArray();
+  json.Field("accel_residual_rms_mps2", result.accel_residual_rms_mps2);
+  json.Field("gyro_residual_rms_rad_per_s", result.gyro_residual_rms_rad_per_s);
+  json.Field("positions", result.positions);
+  json.Key("notes").BeginArray();
+  for (const std::string& n : result.notes) json.Value(n);
+  json.EndArray();
+  json.EndObject();
+  return out.str();
+}
+
+std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::string& rig) {
+  std::ostringstream out;
+  out << "IMU calibration (" << rig << "), " << result.positions
+      << (rig == "pendulum" ? " runs" : " positions") << "\n";
+  char line[160];
+  std::snprintf(line, sizeof(line), "%-28s %14s %12s  %s\n", "parameter", "value", "sigma", "unit");
+  out << line;
+  for (const Row& r : Rows(result.calibration)) {
+    const bool estimated = std::isfinite(r.sigma);
+    char sigma[32];
+    if (estimated) {
+      std::snprintf(sigma, sizeof(sigma), "%12.4g", r.sigma * r.per_si);
+    } else {
+      std::snprintf(sigma, sizeof(sigma), "%12s", "-");
+    }
+    std::snprintf(line, sizeof(line), "%-28s %14.6g %s  %s\n", r.name.c_str(), r.value * r.per_si, sigma, r.unit);
+    out << line;
+  }
+  if (!result.unobservable.empty()) {
+    out << "not observable (held at 0):\n";
+    for (const std::string& u : result.unobservable) out << "  " << u << "\n";
+  }
+  std::snprintf(line, sizeof(line), "residual rms: accel %.4g mg, gyro %.4g deg/h\n",
+                result.accel_residual_rms_mps2 * kMps2ToMg, result.gyro_residual_rms_rad_per_s * kRadPerSToDegPerH);
+  out << line;
+  for (const std::string& n : result.notes) out << "note: " << n << "\n";
+  return out.str();
+}
+
+}  // namespace navtwin::calibration

@@ -1,0 +1,69 @@
+// Multi-position IMU calibration (issue 8 item 2): static positions of a table at known
+// attitudes, optional rate-table rotations between them. docs/calibration-imu.md.
+//
+// Static positions (each hold of the schedule, trimmed by settle_s at both ends): the true
+// f_b = -R_b_n g_n and omega_ib_b = R_b_n omega_ie_n at the table attitude, so the
+// position means give the accelerometer scale, misalignment and bias, the gyro bias and
+// the g-sensitivity. Moves and rotations between two positions: the gyro increments,
+// compensated with the current parameters and integrated, must carry the attitude of one
+// position to the next (Earth rate included) -> gyro scale and misalignment.
+//
+// Batch: Ceres least squares over all positions and moves, sigma from ceres::Covariance
+// scaled by the a-posteriori variance of the residuals; parameters whose direction the
+// data do not excite (e.g. all positions in one plane, no rotation about an axis) are
+// reported in `unobservable` and held at 0, not solved for.
+// Recursive: a Kalman filter over the same parameter vector that takes one position (and
+// the move before it) at a time; after the last position it agrees with the batch.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/sim/calibration_rig.h"
+#include "core/sim/yaml_config.h"
+#include "core/types.h"
+#include "problems/calibration/imu_calibration.h"
+
+namespace navtwin::calibration {
+
+struct MultiPositionData {
+  std::vector<ImuSample> imu;
+  sim::MultiPositionConfig schedule;  ///< times on the IMU's time scale
+  double latitude_rad = 0.0;
+  double height_m = 0.0;
+  std::string imu_path;  ///< for messages
+};
+
+struct MultiPositionOptions {
+  double settle_s = 0.5;           ///< left out at both ends of every hold
+  bool estimate_g_sensitivity = true;
+  /// Specific force magnitude (m/s^2) above which a sample counts as saturated (<= 0: none).
+  double accel_saturation_mps2 = 0.0;
+  double gyro_saturation_rad_per_s = 0.0;
+};
+
+/// Batch calibration. Throws std::runtime_error naming what is missing (fewer than 6
+/// positions, no usable samples in a hold, ...).
+ImuCalibrationResult CalibrateMultiPosition(const MultiPositionData& data, const MultiPositionOptions& options = {});
+
+/// Reads {imu, latitude_deg, height_m, trajectory} from a record node (relative paths
+/// against base_dir). Throws InputError (file, line, key).
+MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::string& base_dir);
+
+/// The recursive form: feed positions in schedule order.
+class RecursiveMultiPosition {
+ public:
+  RecursiveMultiPosition(const MultiPositionData& data, const MultiPositionOptions& options = {});
+  /// Processes the next static position (and the move that led to it); false when done.
+  bool Step();
+  int positions_done() const;
+  /// The current estimate and its covariance (same layout as the batch result).
+  ImuCalibrationResult Current() const;
+
+ private:
+  struct State;
+  std::shared_ptr<State> state_;
+};
+
+}  // namespace navtwin::calibration
