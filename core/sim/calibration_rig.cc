@@ -113,28 +113,10 @@ MultiPositionConfig ParseMultiPosition(const ConfigNode& node) {
   return c;
 }
 
-/// "NED", "DNE", ...: the bob-frame direction (N, E, D, S, W, U) of the IMU x, y, z axes.
-Eigen::Matrix3d MountingFromLetters(const ConfigNode& node, const std::string& key) {
-  const std::string letters = node.String(key, "");
-  const char* shape =
-      "expected three of N, E, D, S, W, U (the directions of the IMU x, y, z "
-      "axes in the bob frame) forming a right-handed frame, e.g. NED, DNE, EDN";
-  if (letters.size() != 3) node.Fail(key, shape);
-  Eigen::Matrix3d R;
-  for (int k = 0; k < 3; ++k) {
-    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(letters[k])));
-    const std::string axes = "NEDSWU";
-    const std::size_t i = axes.find(c);
-    if (i == std::string::npos) node.Fail(key, shape);
-    R.col(k) = Eigen::Vector3d::Unit(static_cast<int>(i % 3)) * (i < 3 ? 1.0 : -1.0);
-  }
-  if (!(R.transpose() * R).isIdentity(0.0) || R.determinant() < 0.0) node.Fail(key, shape);
-  return R;
-}
-
 PendulumConfig ParsePendulum(const ConfigNode& node) {
   node.RequireKeys({"kind", "length_m", "damping_per_s", "c2_per_s2", "initial_angle_deg",
-                    "initial_rate_deg_s", "mounting", "mounting_deg"});
+                    "initial_rate_deg_s", "mounting", "mounting_deg", "angle_noise_deg",
+                    "angle_quantum_deg"});
   PendulumConfig c;
   c.length_m = node.Double("length_m", c.length_m, 0.0, kInf);
   if (!(c.length_m > 0.0)) node.Fail("length_m", "must be > 0");
@@ -145,20 +127,42 @@ PendulumConfig ParsePendulum(const ConfigNode& node) {
   }
   c.initial_angle_rad = node.Double("initial_angle_deg", 30.0, -179.0, 179.0) * kDegToRad;
   c.initial_rate_rad_s = node.Double("initial_rate_deg_s", 0.0) * kDegToRad;
-  if (node.Has("mounting") && node.Has("mounting_deg")) {
-    node.Fail("mounting_deg", "give either mounting (letters) or mounting_deg, not both");
-  }
-  if (node.Has("mounting")) c.mounting_p_b = MountingFromLetters(node, "mounting");
-  if (node.Has("mounting_deg")) {
-    const Eigen::Vector3d e = DegVector(node, "mounting_deg");
-    c.mounting_p_b = DcmFromEuler(e.x(), e.y(), e.z());
-  }
+  c.mounting_p_b = ParsePendulumMounting(node);
+  c.angle_noise_rad = node.NonNegative("angle_noise_deg", 0.0) * kDegToRad;
+  c.angle_quantum_rad = node.NonNegative("angle_quantum_deg", 0.0) * kDegToRad;
   return c;
 }
 
 // -------------------------------------------------------------------- output
 
 }  // namespace
+
+Eigen::Matrix3d ParsePendulumMounting(const ConfigNode& node) {
+  if (node.Has("mounting") && node.Has("mounting_deg")) {
+    node.Fail("mounting_deg", "give either mounting (letters) or mounting_deg, not both");
+  }
+  if (node.Has("mounting_deg")) {
+    const Eigen::Vector3d e = DegVector(node, "mounting_deg");
+    return DcmFromEuler(e.x(), e.y(), e.z());
+  }
+  if (!node.Has("mounting")) return Eigen::Matrix3d::Identity();
+  // "NED", "DNE", ...: the bob-frame direction (N, E, D, S, W, U) of the IMU x, y, z axes.
+  const std::string letters = node.String("mounting", "");
+  const char* shape =
+      "expected three of N, E, D, S, W, U (the directions of the IMU x, y, z "
+      "axes in the bob frame) forming a right-handed frame, e.g. NED, DNE, EDN";
+  if (letters.size() != 3) node.Fail("mounting", shape);
+  Eigen::Matrix3d R;
+  for (int k = 0; k < 3; ++k) {
+    const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(letters[k])));
+    const std::string axes = "NEDSWU";
+    const std::size_t i = axes.find(c);
+    if (i == std::string::npos) node.Fail("mounting", shape);
+    R.col(k) = Eigen::Vector3d::Unit(static_cast<int>(i % 3)) * (i < 3 ? 1.0 : -1.0);
+  }
+  if (!(R.transpose() * R).isIdentity(0.0) || R.determinant() < 0.0) node.Fail("mounting", shape);
+  return R;
+}
 
 CalibrationRigConfig ParseCalibrationRigConfig(const ConfigNode& node) {
   CalibrationRigConfig c;
@@ -417,6 +421,8 @@ void PendulumRig::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::Key << "initial_rate_deg_s" << YAML::Value << config_.initial_rate_rad_s * kRadToDeg;
   EmitMatrix(out, "mounting_p_b", config_.mounting_p_b);
   EmitVector(out, "pivot_axis_b", pivot_axis_b_);
+  out << YAML::Key << "angle_noise_deg" << YAML::Value << config_.angle_noise_rad * kRadToDeg;
+  out << YAML::Key << "angle_quantum_deg" << YAML::Value << config_.angle_quantum_rad * kRadToDeg;
   out << YAML::EndMap;
 }
 

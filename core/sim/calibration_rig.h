@@ -58,6 +58,10 @@ struct PendulumConfig {
   double initial_angle_rad = 0.5235987755982988;  ///< 30 deg
   double initial_rate_rad_s = 0.0;
   Eigen::Matrix3d mounting_p_b = Eigen::Matrix3d::Identity();  ///< R_p_b: IMU axes in the bob frame
+  /// The pivot encoder (angle.csv of `navtwin simulate`): white noise (1 sigma) and the
+  /// quantum of its absolute reading; 0: none.
+  double angle_noise_rad = 0.0;
+  double angle_quantum_rad = 0.0;
 };
 
 struct CalibrationRigConfig {
@@ -70,6 +74,13 @@ struct CalibrationRigConfig {
 /// Parses `trajectory: {kind: multiposition, ...}` or `{kind: pendulum, ...}` (schema in
 /// docs/aiding-models.md). Throws InputError naming the file, line and key.
 CalibrationRigConfig ParseCalibrationRigConfig(const ConfigNode& node);
+
+/// The IMU mounting on a pendulum's bob, R_p_b, from the keys of `node`: `mounting`
+/// (letters: the bob-frame directions N, E, D, S, W, U of the IMU x, y, z axes, e.g. NED,
+/// DNE, EDN) or `mounting_deg` ([roll, pitch, yaw] of R_p_b); identity when neither is
+/// given. Shared by the rig and the pendulum calibration record. Throws InputError naming
+/// the key (both given, letters that are not a right-handed frame).
+Eigen::Matrix3d ParsePendulumMounting(const ConfigNode& node);
 
 /// A rig trajectory that can also describe itself for errors.yaml (rigs draw nothing; they
 /// write the truth a calibration needs: static intervals, c1, c2, the mounting).
@@ -134,6 +145,7 @@ class PendulumRig : public CalibrationRig {
   double AngleAcceleration_rad_s2(double t_s) const { return Swing(t_s).accel; }
   double c1_per_s() const { return c1_; }
   double c2_per_s2() const { return c2_; }
+  const PendulumConfig& config() const { return config_; }
   /// The pivot axis (east) in IMU axes: omega_nb_b = theta' * pivot_axis_b().
   const Eigen::Vector3d& pivot_axis_b() const { return pivot_axis_b_; }
 

@@ -13,6 +13,7 @@
 #include "core/io/csv_mag_baro.h"
 #include "core/io/kfgins.h"
 #include "core/rotation.h"
+#include "core/sim/calibration_rig.h"
 #include "core/sim/truth.h"
 
 namespace navtwin::sim {
@@ -42,6 +43,33 @@ void PushAndWrite(Simulator* simulator, Writer* writer, const TruthSample& truth
     ++*count;
   }
 }
+
+/// The pendulum's pivot encoder: the true angle plus white noise, read to a multiple of the
+/// quantum (an absolute encoder: the rounding error does not carry over); angle.csv.
+class AngleEncoder {
+ public:
+  AngleEncoder(const PendulumRig& rig, const Rng& rng, bool perfect, const std::string& path)
+      : rig_(rig), rng_(rng), file_(path) {
+    if (!perfect) {
+      noise_rad_ = rig.config().angle_noise_rad;
+      quantum_rad_ = rig.config().angle_quantum_rad;
+    }
+    file_.stream() << "t_s,theta_rad\n";
+  }
+  /// The reading at the truth time truth_t_s, tagged t_s (the IMU sample's time tag).
+  void Write(double t_s, double truth_t_s) {
+    double theta = rig_.Angle_rad(truth_t_s) + rng_.Normal(noise_rad_);
+    if (quantum_rad_ > 0.0) theta = quantum_rad_ * std::round(theta / quantum_rad_);
+    file_.stream() << t_s << ',' << theta << '\n';
+  }
+  void Commit() { file_.Commit(); }
+
+ private:
+  const PendulumRig& rig_;
+  Rng rng_;
+  AtomicFile file_;
+  double noise_rad_ = 0.0, quantum_rad_ = 0.0;
+};
 
 }  // namespace
 
@@ -87,6 +115,11 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
     master_out = std::make_unique<KfginsNavWriter>(path("master.nav"));
   }
 
+  std::unique_ptr<AngleEncoder> angle_out;
+  if (const auto* rig = dynamic_cast<const PendulumRig*>(scenario.trajectory.get())) {
+    angle_out = std::make_unique<AngleEncoder>(*rig, rng.Stream("angle"), perfect, path("angle.csv"));
+  }
+
   const long n = std::lround(scenario.duration_s * imu.internal_rate_hz());
   const long progress_step = std::max(1L, n / 20);
   for (long k = 0; k <= n; ++k) {
@@ -98,6 +131,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
     if (const auto s = imu.Push(t)) {
       imu_out.Write(*s);
       truth_out.Write(t.state);
+      if (angle_out) angle_out->Write(s->t_s, t.t_s);
       ++report.imu_samples;
     }
     PushAndWrite(gnss.get(), gnss_out.get(), t, &report.gnss_samples);
@@ -148,6 +182,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
   imu_out.Commit();
   truth_out.Commit();
   init_out.Commit();
+  if (angle_out) angle_out->Commit();
   if (gnss_out) gnss_out->Commit();
   if (mag_out) mag_out->Commit();
   if (baro_out) baro_out->Commit();

@@ -6,6 +6,8 @@
 //   mag.csv    t_s,mx_uT,my_uT,mz_uT                           when it has mag
 //   baro.csv   t_s,pressure_pa,altitude_m,temperature_degC     when it has baro
 //   master.nav KF-GINS navigation format, delivered late        when it has master
+//   angle.csv  t_s,theta_rad: the pivot encoder, one reading per IMU sample (its time tag),
+//              the angle at that sample's truth time              when it is a pendulum rig
 //   errors.yaml every drawn error value, with units in the keys, and the seed
 // All files appear whole or not at all. Times start at 0 s (GPS week 0).
 #pragma once

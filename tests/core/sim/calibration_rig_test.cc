@@ -290,10 +290,25 @@ TEST(CalibrationRigTest, BadRigConfigurationsNameTheKey) {
   expect_error(Pendulum("  mounting: NEU\n"), "right-handed");
   expect_error(Pendulum("  mounting: NED\n  mounting_deg: [0, 0, 0]\n"), "not both");
   expect_error(Pendulum("  length: 1\n"), "unknown key");
+  expect_error(Pendulum("  angle_noise_deg: -0.01\n"), "trajectory.angle_noise_deg");
   expect_error(Pendulum("  initial_rate_deg_s: 2000\n"), "over the top");
   // x within 0.01 deg of the swing plane passes within 0.01 deg of the vertical.
   expect_error(Pendulum("  mounting_deg: [0, -89.99, 0.01]\n  initial_angle_deg: 5\n"),
                "too close to the vertical");
+}
+
+TEST(CalibrationRigTest, PendulumMountingParserAndEncoderKeys) {
+  // The parser the pendulum calibration record shares with the rig.
+  const auto mounting = [](const std::string& text) { return ParsePendulumMounting(ParseYaml(text, "m.yaml")); };
+  Eigen::Matrix3d dne;
+  dne << 0, 1, 0, 0, 0, 1, 1, 0, 0;  // IMU x down, y north, z east: columns in the bob frame
+  EXPECT_TRUE(mounting("mounting: DNE").isApprox(dne, 0.0));
+  EXPECT_TRUE(mounting("other: 1").isIdentity(0.0));
+  EXPECT_TRUE(mounting("mounting_deg: [30, 0, 30]").isApprox(DcmFromEuler(M_PI / 6, 0.0, M_PI / 6), 1e-15));
+  const CalibrationRigConfig c = Parse(Pendulum("  angle_noise_deg: 0.01\n  angle_quantum_deg: 0.002\n"));
+  EXPECT_DOUBLE_EQ(c.pendulum.angle_noise_rad, 0.01 * kDegToRad);
+  EXPECT_DOUBLE_EQ(c.pendulum.angle_quantum_rad, 0.002 * kDegToRad);
+  EXPECT_EQ(Parse(Pendulum("")).pendulum.angle_noise_rad, 0.0);  // default: a perfect encoder
 }
 
 TEST(CalibrationRigTest, EmitDrawnDescribesTheRig) {

@@ -15,6 +15,7 @@
 #include "core/io/input_error.h"
 #include "core/io/kfgins.h"
 #include "core/rotation.h"
+#include "core/sim/calibration_rig.h"
 #include "core/sim/presets.h"
 #include "core/strapdown.h"
 
@@ -144,6 +145,53 @@ TEST(Simulator, CalibrationRigScenariosRoundTrip) {
     const YAML::Node errors = YAML::LoadFile(dir + "/errors.yaml");
     EXPECT_TRUE(errors["trajectory"]) << scenario.name << ": the rig's truth is not in errors.yaml";
   }
+  RemoveDir(dir);
+}
+
+// A pendulum scenario also writes the pivot encoder, angle.csv: one reading per IMU sample
+// with its time tag, the rig's angle plus white noise, rounded to the encoder's quantum.
+TEST(Simulator, PendulumWritesTheEncoderAngle) {
+  const std::string dir = MakeTempDir();
+  const std::string yaml =
+      "name: pendulum\nduration_s: 20\nstart: {lat_deg: 37.45, lon_deg: 126.65, h_m: 20}\n"
+      "trajectory: {kind: pendulum, length_m: 0.8, damping_per_s: 0.05, initial_angle_deg: 40,"
+      " mounting: NED, angle_noise_deg: 0.01, angle_quantum_deg: 0.001}\nimu: {rate_hz: 100}\n";
+  const Scenario scenario = ParseScenario(ParseYaml(yaml, "pendulum.yaml"));
+  const auto& rig = dynamic_cast<const PendulumRig&>(*scenario.trajectory);
+  for (const bool perfect : {false, true}) {
+    SimulationOptions options;
+    options.perfect = perfect;
+    const SimulationReport report = Simulate(scenario, options, dir);
+    std::ifstream in(dir + "/angle.csv");
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "t_s,theta_rad");
+    auto imu = OpenKfginsImu(dir + "/imu.txt");
+    ImuSample s;
+    std::size_t rows = 0;
+    double sum2 = 0.0, worst_quantum = 0.0;
+    constexpr double kQuantum = 0.001 * kDegToRad;
+    while (std::getline(in, line) && imu->Next(&s)) {
+      const double t = std::stod(line.substr(0, line.find(','))), theta = std::stod(line.substr(line.find(',') + 1));
+      EXPECT_EQ(t, s.t_s);
+      const double e = theta - rig.Angle_rad(t);
+      sum2 += e * e;
+      worst_quantum = std::max(worst_quantum, std::fabs(theta / kQuantum - std::round(theta / kQuantum)));
+      ++rows;
+    }
+    EXPECT_EQ(rows, report.imu_samples);
+    const double rms_deg = std::sqrt(sum2 / rows) * kRadToDeg;
+    if (perfect) {
+      EXPECT_EQ(rms_deg, 0.0);  // --perfect: the true angle
+    } else {
+      // 2000 readings of 0.01 deg noise and a 0.001 deg quantum (its rms 0.0003 deg): the
+      // rms within 5 % of the noise (its relative sigma 1.6 %), every reading a multiple.
+      EXPECT_NEAR(rms_deg, 0.01, 0.0005);
+      EXPECT_LT(worst_quantum, 1e-6);
+    }
+  }
+  const YAML::Node errors = YAML::LoadFile(dir + "/errors.yaml");
+  EXPECT_DOUBLE_EQ(errors["trajectory"]["angle_noise_deg"].as<double>(), 0.01);
   RemoveDir(dir);
 }
 
