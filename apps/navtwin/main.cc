@@ -23,13 +23,17 @@ Command InflightMcCommand();
 // cmd_transfer.cc
 Command TransferAlignCommand();
 Command TransferAlignAnsflCommand();  // cmd_transfer_ansfl.cc
+Command CalibrateMagCommand();        // cmd_calibrate_mag.cc
+Command CalibrateImuCommand();        // cmd_calibrate_imu.cc
 
 namespace {
 
 std::vector<Command> AllCommands() {
-  return {InfoCommand(),     ConvertCommand(),  InsCommand(),   SimulateCommand(),
-          AllanCommand(),    NavigateCommand(), SmoothCommand(),  LevelCommand(),
-          LevelMcCommand(),  InflightAlignCommand(), InflightMcCommand(), TransferAlignCommand(), TransferAlignAnsflCommand()};
+  return {InfoCommand(),          ConvertCommand(),       InsCommand(),
+          SimulateCommand(),      AllanCommand(),         NavigateCommand(),
+          SmoothCommand(),        LevelCommand(),         LevelMcCommand(),
+          InflightAlignCommand(), InflightMcCommand(),    TransferAlignCommand(),
+          TransferAlignAnsflCommand(), CalibrateImuCommand(), CalibrateMagCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {

@@ -1,0 +1,94 @@
+// navtwin calibrate-imu --data RECORD --rig multiposition|pendulum|temperature: the IMU error
+// model (scale factor, misalignment, bias, gyro g-sensitivity; temperature polynomials)
+// from a calibration record (problems/calibration/imu_calibration.h, docs/calibration-imu.md),
+// printed with one sigma per parameter and written as a calibration file (--out) that every
+// IMU reader applies with --calibration.
+#include <gflags/gflags.h>
+
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/navtwin/command.h"
+#include "core/calibration_file.h"
+#include "problems/calibration/imu_calibration.h"
+
+DECLARE_string(format);
+DECLARE_string(data);
+DECLARE_string(out);
+DEFINE_string(rig, "", "calibrate-imu: multiposition, pendulum or temperature (what --data records)");
+
+namespace navtwin::app {
+
+Command CalibrateImuCommand();
+namespace {
+
+int Usage(const std::string& why) {
+  const std::string usage = CalibrateImuCommand().usage;
+  std::cerr << "navtwin calibrate-imu: " << why << "\nusage: " << usage.substr(0, usage.find('\n'))
+            << "\n(navtwin calibrate-imu --help: the record files)\n";
+  return kExitUsage;
+}
+
+/// The command line as one string, for the file's created_by.
+std::string CommandLine() {
+  std::ostringstream s;
+  s << "navtwin calibrate-imu --rig " << FLAGS_rig << " --data " << FLAGS_data;
+  return s.str();
+}
+
+int RunCalibrateImu(const std::vector<std::string>& args) {
+  if (!args.empty()) return Usage("unexpected argument '" + args.front() + "' (the record goes in --data)");
+  if (FLAGS_data.empty()) return Usage("--data RECORD is required");
+  if (FLAGS_format != "text" && FLAGS_format != "json") return Usage("--format must be text or json");
+  calibration::ImuCalibrationResult result;
+  if (FLAGS_rig == "multiposition") {
+    result = calibration::CalibrateMultiPositionRecord(FLAGS_data);
+  } else if (FLAGS_rig == "pendulum") {
+    result = calibration::CalibratePendulumRecord(FLAGS_data);
+  } else if (FLAGS_rig == "temperature") {
+    result = calibration::CalibrateTemperatureRecord(FLAGS_data);
+  } else if (FLAGS_rig.empty()) {
+    return Usage("--rig is required: multiposition, pendulum or temperature");
+  } else {
+    return Usage("unknown --rig '" + FLAGS_rig + "': multiposition, pendulum or temperature");
+  }
+  if (!FLAGS_out.empty()) {
+    CalibrationFile file;
+    file.created_by = CommandLine();
+    file.imu = result.calibration;
+    WriteCalibrationFile(FLAGS_out, file);
+  }
+  if (FLAGS_format == "json") {
+    std::cout << calibration::ImuCalibrationJson(result, FLAGS_rig) << "\n";
+  } else {
+    std::cout << calibration::ImuCalibrationText(result, FLAGS_rig);
+    if (!FLAGS_out.empty()) std::cout << "calibration file: " << FLAGS_out << "\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command CalibrateImuCommand() {
+  return {"calibrate-imu",
+          "IMU scale factor, misalignment, bias and g-sensitivity (with sigma) from a calibration record",
+          "navtwin calibrate-imu --data RECORD --rig multiposition|pendulum|temperature [--out FILE] "
+          "[--format=json]\n"
+          "  RECORD is a YAML file naming the IMU files and what the rig did (docs/calibration-imu.md):\n"
+          "  - multiposition: {imu, latitude_deg, height_m, trajectory: {kind: multiposition, ...}}, the\n"
+          "    table schedule in the simulator's schema, on the IMU's time scale;\n"
+          "  - pendulum: {latitude_deg, height_m, runs: [{imu, angle, length_m, mounting}, ...]}, the\n"
+          "    angle files t_s,theta_rad from the pivot encoder (docs/calibration-pendulum.md);\n"
+          "  - temperature: {order, latitude_deg, height_m, runs: [{temperature_degC, imu, trajectory}]},\n"
+          "    one multi-position schedule per chamber temperature (docs/calibration-temperature.md).\n"
+          "  Prints every parameter with one sigma and the parameters the data cannot observe (held\n"
+          "  at 0); --out writes the calibration file that --calibration applies to IMU readers.\n"
+          "  Exit 1 for records that cannot calibrate (too few positions, a temperature span too\n"
+          "  small for the order, ...), with what is missing; nothing is written then.",
+          {"data", "rig", "out"},
+          &RunCalibrateImu};
+}
+
+}  // namespace navtwin::app

@@ -1,0 +1,307 @@
+// navtwin calibrate-mag: hard and soft iron of a magnetometer record by the 3-axis ellipsoid
+// fit or the seed's 2-axis bidirectional method (problems/calibration/mag_calibration.h);
+// prints the calibration, the field-magnitude spread and, with --truth, the heading error
+// before and after; --out writes the calibration file (core/calibration_file.h).
+//
+// Roll and pitch (for the bidirectional tilt gate and for the tilt-compensated heading)
+// come from --truth when given, else from the --imu accelerometer (the mean specific force
+// of the IMU samples within half a magnetometer interval of each sample, levelled as in
+// core/leveling_model.h), else every sample is taken as level. The bidirectional method
+// runs without either (a level turn is its premise) and says so on stderr.
+#include <gflags/gflags.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/navtwin/command.h"
+#include "core/calibration_file.h"
+#include "core/io/input_error.h"
+#include "core/io/json_writer.h"
+#include "core/io/open.h"
+#include "core/leveling_model.h"
+#include "core/rotation.h"
+#include "problems/calibration/mag_calibration.h"
+
+DECLARE_string(format);  // main.cc
+DECLARE_string(mag);     // cmd_navigate.cc
+DECLARE_string(imu);     // cmd_ins.cc
+DECLARE_string(truth);   // cmd_ins.cc
+DECLARE_string(out);     // cmd_ins.cc
+DECLARE_string(method);  // cmd_inflight.cc
+DEFINE_double(declination_deg, 0.0,
+              "calibrate-mag: magnetic declination (east positive) added to the magnetic heading, deg");
+DEFINE_double(field_uT, 0.0,
+              "calibrate-mag: Earth field magnitude the ellipsoid fit scales to, uT (0: the data's mean)");
+
+namespace navtwin::app {
+
+Command CalibrateMagCommand();
+
+namespace {
+
+using calibration::MagCalibration;
+
+/// Heading is not reported where the x axis is within this angle of the vertical: roll and
+/// heading are not separable there (and an accelerometer cannot give roll).
+constexpr double kMaxHeadingPitch_rad = 80.0 * kDegToRad;
+
+int Usage(const std::string& why) {
+  std::cerr << "navtwin calibrate-mag: " << why << "\nusage: " << CalibrateMagCommand().usage << "\n";
+  return kExitUsage;
+}
+
+/// Roll, pitch, yaw (rad) at time t from a sorted navigation record (attitude slerped
+/// between the two records around t); nullopt outside the record.
+std::optional<Eigen::Vector3d> TruthEuler(const std::vector<NavState>& nav, double t_s) {
+  if (nav.empty() || t_s < nav.front().t_s || t_s > nav.back().t_s) return std::nullopt;
+  const auto it = std::lower_bound(nav.begin(), nav.end(), t_s, [](const NavState& s, double t) { return s.t_s < t; });
+  if (it->t_s == t_s || it == nav.begin()) return EulerFromQuat(it->q_n_b);
+  const NavState& a = *(it - 1);
+  const double w = (t_s - a.t_s) / (it->t_s - a.t_s);
+  return EulerFromQuat(a.q_n_b.slerp(w, it->q_n_b));
+}
+
+/// Roll and pitch from the mean specific force of the IMU samples whose time lies within
+/// half_window_s of each magnetometer sample (the nearest sample when none does); nullopt
+/// outside the IMU record.
+class AccelLevel {
+ public:
+  AccelLevel(std::vector<ImuSample> imu, double half_window_s) : imu_(std::move(imu)), half_(half_window_s) {
+    sum_dv_.push_back(Eigen::Vector3d::Zero());
+    sum_dt_.push_back(0.0);
+    for (const ImuSample& s : imu_) {
+      sum_dv_.push_back(sum_dv_.back() + s.dv_b_mps);
+      sum_dt_.push_back(sum_dt_.back() + s.dt_s);
+    }
+  }
+  std::optional<Eigen::Vector2d> At(double t_s) const {
+    if (imu_.empty() || t_s < imu_.front().t_s - imu_.front().dt_s - half_ || t_s > imu_.back().t_s + half_) {
+      return std::nullopt;
+    }
+    const auto by_time = [](const ImuSample& s, double t) { return s.t_s < t; };
+    std::size_t lo = std::lower_bound(imu_.begin(), imu_.end(), t_s - half_, by_time) - imu_.begin();
+    std::size_t hi = std::lower_bound(imu_.begin(), imu_.end(), t_s + half_, by_time) - imu_.begin();
+    if (hi <= lo) {  // no sample inside the window: the one nearest to t
+      lo = std::min(lo, imu_.size() - 1);
+      hi = lo + 1;
+    }
+    const Eigen::Vector3d f_b_mps2 = (sum_dv_[hi] - sum_dv_[lo]) / (sum_dt_[hi] - sum_dt_[lo]);
+    const leveling::RollPitch level = leveling::LevelFromSpecificForce(f_b_mps2);
+    return Eigen::Vector2d(level.roll_rad, level.pitch_rad);
+  }
+
+ private:
+  std::vector<ImuSample> imu_;
+  double half_;
+  std::vector<Eigen::Vector3d> sum_dv_;
+  std::vector<double> sum_dt_;
+};
+
+double MedianInterval(const std::vector<MagSample>& mag) {
+  std::vector<double> dt;
+  for (std::size_t i = 1; i < mag.size(); ++i) dt.push_back(mag[i].t_s - mag[i - 1].t_s);
+  if (dt.empty()) return 0.0;
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  return dt[dt.size() / 2];
+}
+
+struct HeadingErrors {
+  int samples = 0;
+  double before_deg = NAN;  ///< RMS; NaN (printed n/a, JSON null) without truth
+  double after_deg = NAN;
+};
+
+/// RMS over the samples with truth of the wrapped heading minus the truth yaw, from the raw
+/// and from the calibrated field: tilt-compensated (3-axis) for the ellipsoid fit, level
+/// (x, y only) for the 2-axis bidirectional method.
+HeadingErrors HeadingError(const std::vector<MagSample>& mag, const std::vector<std::optional<Eigen::Vector3d>>& truth,
+                           const MagCalibration& c, bool two_axis, double declination_rad) {
+  HeadingErrors e;
+  double sum_before = 0.0, sum_after = 0.0;
+  const auto heading = [&](const Eigen::Vector3d& m, const Eigen::Vector3d& euler) {
+    return two_axis ? calibration::LevelHeading(m, declination_rad)
+                    : calibration::TiltCompensatedHeading(m, euler[0], euler[1], declination_rad);
+  };
+  for (std::size_t i = 0; i < mag.size(); ++i) {
+    if (!truth[i] || std::abs((*truth[i])[1]) > kMaxHeadingPitch_rad) continue;
+    const double before = WrapPi(heading(mag[i].m_b_uT, *truth[i]) - (*truth[i])[2]);
+    const double after = WrapPi(heading(calibration::ApplyMagCalibration(c, mag[i].m_b_uT), *truth[i]) - (*truth[i])[2]);
+    sum_before += before * before;
+    sum_after += after * after;
+    ++e.samples;
+  }
+  if (e.samples > 0) {
+    e.before_deg = std::sqrt(sum_before / e.samples) * kRadToDeg;
+    e.after_deg = std::sqrt(sum_after / e.samples) * kRadToDeg;
+  }
+  return e;
+}
+
+/// The command as run, for the calibration file's created_by: the flags of this command
+/// that were set.
+std::string CommandLine() {
+  std::string line = "navtwin calibrate-mag";
+  std::vector<std::string> flags = CalibrateMagCommand().flags;
+  flags.push_back("format");
+  for (const std::string& name : flags) {
+    gflags::CommandLineFlagInfo info;
+    if (gflags::GetCommandLineFlagInfo(name.c_str(), &info) && info.current_value != info.default_value) {
+      line += " --" + name + "=" + info.current_value;
+    }
+  }
+  return line;
+}
+
+std::string Fixed(double x, int digits) {
+  if (!std::isfinite(x)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, x);
+  return buf;
+}
+
+void PrintText(const MagCalibration& c, const HeadingErrors& h, const std::string& attitude) {
+  std::printf("magnetometer calibration (%s): %d samples, %d down-weighted, roll/pitch from %s\n", c.method.c_str(),
+              c.samples, c.downweighted, attitude.c_str());
+  std::printf("  hard iron [uT]        %10.4f %10.4f %10.4f\n", c.hard_iron_uT.x(), c.hard_iron_uT.y(),
+              c.hard_iron_uT.z());
+  std::printf("  hard iron sigma [uT]  %10.4f %10.4f %10.4f\n", c.hard_iron_sigma_uT.x(), c.hard_iron_sigma_uT.y(),
+              c.hard_iron_sigma_uT.z());
+  for (int r = 0; r < 3; ++r) {
+    std::printf("  %-21s %10.6f %10.6f %10.6f\n", r == 0 ? "soft iron A" : "", c.correction(r, 0), c.correction(r, 1),
+                c.correction(r, 2));
+  }
+  std::printf("  field [uT]            %10.4f\n", c.field_uT);
+  std::printf("  residual RMS [uT]     %10.4f\n", c.residual_rms_uT);
+  std::printf("  |m| spread [uT]       before %s  after %s\n", Fixed(c.field_spread_before_uT, 4).c_str(),
+              Fixed(c.field_spread_after_uT, 4).c_str());
+  std::printf("  heading error RMS [deg] before %s  after %s  (%d samples with truth)\n",
+              Fixed(h.before_deg, 3).c_str(), Fixed(h.after_deg, 3).c_str(), h.samples);
+}
+
+void PrintJson(const MagCalibration& c, const HeadingErrors& h, const std::string& attitude) {
+  JsonWriter w(std::cout);
+  w.BeginObject().Key("hard_iron_uT").BeginArray();
+  for (int i = 0; i < 3; ++i) w.Value(c.hard_iron_uT[i]);
+  w.EndArray().Key("hard_iron_sigma_uT").BeginArray();
+  for (int i = 0; i < 3; ++i) w.Value(c.hard_iron_sigma_uT[i]);
+  w.EndArray().Key("soft_iron").BeginArray();
+  for (int r = 0; r < 3; ++r) {
+    w.BeginArray();
+    for (int k = 0; k < 3; ++k) w.Value(c.correction(r, k));
+    w.EndArray();
+  }
+  w.EndArray()
+      .Field("field_uT", c.field_uT)
+      .Field("residual_rms_uT", c.residual_rms_uT)
+      .Field("heading_error_before_deg", h.before_deg)  // NaN -> null (no truth)
+      .Field("heading_error_after_deg", h.after_deg)
+      .Field("heading_samples", h.samples)
+      .Field("field_spread_before_uT", c.field_spread_before_uT)
+      .Field("field_spread_after_uT", c.field_spread_after_uT)
+      .Field("samples", c.samples)
+      .Field("downweighted", c.downweighted)
+      .Field("method", c.method)
+      .Field("attitude", attitude)
+      .EndObject();
+  std::cout << "\n";
+}
+
+int RunCalibrateMag(const std::vector<std::string>& args) {
+  if (!args.empty()) return Usage("unexpected argument '" + args.front() + "'");
+  if (FLAGS_mag.empty()) return Usage("--mag FILE is required");
+  if (FLAGS_method != "ellipsoid" && FLAGS_method != "bidirectional") {
+    return Usage("--method must be ellipsoid or bidirectional, got '" + FLAGS_method + "'");
+  }
+  if (!std::isfinite(FLAGS_declination_deg)) return Usage("--declination_deg must be a finite angle, deg");
+  if (!(std::isfinite(FLAGS_field_uT) && FLAGS_field_uT >= 0.0)) return Usage("--field_uT must be >= 0 (0: from the data)");
+  const bool two_axis = FLAGS_method == "bidirectional";
+  if (two_axis && FLAGS_field_uT != 0.0) return Usage("--field_uT goes with --method ellipsoid");
+
+  std::vector<MagSample> mag = ReadAll<MagSample>(*OpenMag(FLAGS_mag));
+  if (mag.empty()) throw InputError(FLAGS_mag, 0, "t_s", "no magnetometer samples");
+
+  // Attitude per sample: roll, pitch (and yaw from the truth).
+  std::vector<std::optional<Eigen::Vector3d>> truth(mag.size());
+  std::vector<std::optional<Eigen::Vector2d>> roll_pitch(mag.size());
+  std::string attitude = "level (assumed)";
+  if (!FLAGS_truth.empty()) {
+    attitude = "truth";
+    const std::vector<NavState> nav = ReadAll<NavState>(*OpenNav(FLAGS_truth));
+    for (std::size_t i = 0; i < mag.size(); ++i) {
+      truth[i] = TruthEuler(nav, mag[i].t_s);
+      if (truth[i]) roll_pitch[i] = truth[i]->head<2>();
+    }
+    if (!FLAGS_imu.empty()) std::cerr << "calibrate-mag: --truth gives roll and pitch; --imu is not used\n";
+  } else if (!FLAGS_imu.empty()) {
+    attitude = "imu accelerometer";
+    const AccelLevel level(ReadAll<ImuSample>(*OpenImu(FLAGS_imu)), 0.5 * MedianInterval(mag));
+    for (std::size_t i = 0; i < mag.size(); ++i) roll_pitch[i] = level.At(mag[i].t_s);
+  } else {
+    for (auto& rp : roll_pitch) rp = Eigen::Vector2d::Zero();
+    if (two_axis) std::cerr << "calibrate-mag: no --truth or --imu: every sample is taken as level\n";
+  }
+
+  MagCalibration c;
+  if (two_axis) {
+    // Only the samples with an attitude enter the tilt-gated fit.
+    std::vector<MagSample> used;
+    std::vector<Eigen::Vector2d> used_rp;
+    for (std::size_t i = 0; i < mag.size(); ++i) {
+      if (!roll_pitch[i]) continue;
+      used.push_back(mag[i]);
+      used_rp.push_back(*roll_pitch[i]);
+    }
+    if (used.size() < mag.size()) {
+      std::cerr << "calibrate-mag: " << mag.size() - used.size()
+                << " samples outside the attitude record (" << (FLAGS_truth.empty() ? FLAGS_imu : FLAGS_truth)
+                << ") are left out\n";
+    }
+    c = calibration::FitBidirectional(used, used_rp);
+  } else {
+    calibration::EllipsoidFitOptions options;
+    options.field_uT = FLAGS_field_uT;
+    c = calibration::FitEllipsoid(mag, options);
+  }
+  const HeadingErrors heading = HeadingError(mag, truth, c, two_axis, FLAGS_declination_deg * kDegToRad);
+  if (!FLAGS_truth.empty() && heading.samples == 0) {
+    std::cerr << "calibrate-mag: warning: no magnetometer sample inside " << FLAGS_truth
+              << " (with |pitch| <= 80 deg): heading errors are n/a\n";
+  }
+
+  if (!FLAGS_out.empty()) {
+    CalibrationFile file;
+    file.created_by = CommandLine();
+    file.mag = MagCorrection{c.hard_iron_uT, c.correction, c.field_uT};
+    WriteCalibrationFile(FLAGS_out, file);
+  }
+  if (FLAGS_format == "json") {
+    PrintJson(c, heading, attitude);
+  } else {
+    PrintText(c, heading, attitude);
+    if (!FLAGS_out.empty()) std::printf("calibration file: %s\n", FLAGS_out.c_str());
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+Command CalibrateMagCommand() {
+  return {"calibrate-mag",
+          "Magnetometer hard and soft iron: 3-axis ellipsoid fit or the 2-axis bidirectional method",
+          "navtwin calibrate-mag --mag F --method ellipsoid|bidirectional [--imu F] [--truth NAV] "
+          "[--declination_deg D] [--field_uT B] [--out FILE] [--format=json]\n"
+          "  Roll and pitch come from --truth, else the --imu accelerometer, else level; the heading error\n"
+          "  before and after needs --truth (else n/a). --out writes the calibration file\n"
+          "  (docs/calibration-file.md) that --calibration applies. Data that cannot calibrate (too little\n"
+          "  rotation) exits 1 with the reason and writes no file.",
+          {"mag", "imu", "truth", "method", "out", "declination_deg", "field_uT"},
+          &RunCalibrateMag};
+}
+
+}  // namespace navtwin::app
