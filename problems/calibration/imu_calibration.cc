@@ -77,6 +77,51 @@ std::vector<Row> Rows(const ImuCalibration& c) {
   return rows;
 }
 
+/// Sigma of the estimated parameter `name` from the result's covariance (NaN if absent).
+double SigmaByName(const ImuCalibrationResult& result, const std::string& name) {
+  for (std::size_t i = 0; i < result.estimated.size(); ++i) {
+    if (result.estimated[i] == name && static_cast<Eigen::Index>(i) < result.covariance.rows()) {
+      return std::sqrt(result.covariance(i, i));
+    }
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+/// The temperature coefficients (`<triad>.bias.x.dT1`, `<triad>.scale_factor.z.dT2`, ...),
+/// each per degC^k, with the sigma of the temperature calibration's covariance.
+std::vector<Row> TemperatureRows(const ImuCalibrationResult& result) {
+  std::vector<Row> rows;
+  if (!result.calibration.temperature) return rows;
+  const TemperatureTerms& t = *result.calibration.temperature;
+  const auto terms = [&](const std::string& prefix, const std::vector<Eigen::Vector3d>& coefficients, double per_si,
+                         const char* unit) {
+    for (std::size_t k = 0; k < coefficients.size(); ++k) {
+      for (int a = 0; a < 3; ++a) {
+        Row r;
+        r.name = prefix + kAxis[a] + ".dT" + std::to_string(k + 1);
+        r.value = coefficients[k](a);
+        r.sigma = SigmaByName(result, r.name);
+        r.per_si = per_si;
+        r.unit = unit;
+        rows.push_back(r);
+      }
+    }
+  };
+  terms("accel.scale_factor.", t.accel_scale_factor, 1e6, "ppm/degC^k");
+  terms("accel.bias.", t.accel_bias_mps2, kMps2ToMg, "mg/degC^k");
+  terms("gyro.scale_factor.", t.gyro_scale_factor, 1e6, "ppm/degC^k");
+  terms("gyro.bias.", t.gyro_bias_rad_per_s, kRadPerSToDegPerH, "deg/h/degC^k");
+  return rows;
+}
+
+/// Every row of a report: the constant blocks, then the temperature coefficients.
+std::vector<Row> AllRows(const ImuCalibrationResult& result) {
+  std::vector<Row> rows = Rows(result.calibration);
+  const std::vector<Row> temperature = TemperatureRows(result);
+  rows.insert(rows.end(), temperature.begin(), temperature.end());
+  return rows;
+}
+
 }  // namespace
 
 std::string TriadParameterName(const std::string& triad, int index) {
@@ -104,7 +149,7 @@ std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::st
   json.BeginObject();
   json.Field("rig", rig);
   json.Key("parameters").BeginObject();
-  for (const Row& r : Rows(result.calibration)) {
+  for (const Row& r : AllRows(result)) {
     json.Key(r.name).BeginObject();
     json.Field("value", r.value);
     json.Field("sigma", r.sigma);  // NaN (not estimated) is written as null
@@ -114,6 +159,7 @@ std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::st
   json.Key("unobservable").BeginArray();
   for (const std::string& u : result.unobservable) json.Value(u);
   json.EndArray();
+  if (result.calibration.temperature) json.Field("reference_degC", result.calibration.temperature->reference_degC);
   json.Field("accel_residual_rms_mps2", result.accel_residual_rms_mps2);
   json.Field("gyro_residual_rms_rad_per_s", result.gyro_residual_rms_rad_per_s);
   json.Field("positions", result.positions);
@@ -131,7 +177,7 @@ std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::st
   char line[160];
   std::snprintf(line, sizeof(line), "%-28s %14s %12s  %s\n", "parameter", "value", "sigma", "unit");
   out << line;
-  for (const Row& r : Rows(result.calibration)) {
+  for (const Row& r : AllRows(result)) {
     const bool estimated = std::isfinite(r.sigma);
     char sigma[32];
     if (estimated) {
@@ -140,6 +186,11 @@ std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::st
       std::snprintf(sigma, sizeof(sigma), "%12s", "-");
     }
     std::snprintf(line, sizeof(line), "%-28s %14.6g %s  %s\n", r.name.c_str(), r.value * r.per_si, sigma, r.unit);
+    out << line;
+  }
+  if (result.calibration.temperature) {
+    std::snprintf(line, sizeof(line), "temperature terms: coefficient k of (T - %.6g degC)^k\n",
+                  result.calibration.temperature->reference_degC);
     out << line;
   }
   if (!result.unobservable.empty()) {
