@@ -2,8 +2,9 @@
 # Does an IMU calibration pay off in navigation? For each seed: calibrate a MEMS IMU with
 # large fixed errors on a simulated 14-position table (table-mems.yaml), then navigate a
 # GNSS/INS manoeuvre flight of the same IMU (nav-mems-fixed-errors.yaml) with 30 s GNSS
-# outages every 90 s, once raw with the data-sheet configuration and once with
-# --calibration and the configuration of the residual errors. Prints navigate's error line.
+# outages every 90 s: raw with the data-sheet configuration, with --calibration and the
+# configuration of the residual errors, and (no_file) that configuration without the
+# calibration file. Prints smooth's error lines (filter, RTS, batch).
 # Usage: docs/calibration/compensation.sh [NAVTWIN_BINARY] [SEEDS]
 #        (defaults: build/bin/navtwin, "1 2 3")
 set -eu
@@ -25,9 +26,12 @@ for seed in $seeds; do
   "$navtwin" calibrate-imu --rig multiposition --data "$d/record.yaml" --out "$d/calibration.yaml" > /dev/null
   "$navtwin" simulate --scenario "$here/nav-mems-fixed-errors.yaml" --seed "$seed" --out "$d/nav" > /dev/null 2>&1
   cp "$here/navtwin-datasheet.yaml" "$here/navtwin-calibrated.yaml" "$d/nav/"
-  for run in raw calibrated; do
-    if [ $run = raw ]; then extra="--config $d/nav/navtwin-datasheet.yaml"
-    else extra="--config $d/nav/navtwin-calibrated.yaml --calibration $d/calibration.yaml"; fi
+  for run in raw calibrated no_file; do
+    case $run in
+      raw) extra="--config $d/nav/navtwin-datasheet.yaml" ;;
+      calibrated) extra="--config $d/nav/navtwin-calibrated.yaml --calibration $d/calibration.yaml" ;;
+      no_file) extra="--config $d/nav/navtwin-calibrated.yaml" ;;  # the residual-error configuration alone
+    esac
     # shellcheck disable=SC2086
     "$navtwin" smooth --imu "$d/nav/imu.txt" --gnss "$d/nav/gnss.txt" --truth "$d/nav/truth.nav" \
       --out "$d/out_$run" --outage_start_s 60 --outage_len_s 30 --outage_period_s 90 $extra 2>/dev/null |
