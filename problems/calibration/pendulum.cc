@@ -250,59 +250,27 @@ std::string ParameterName(int g) {
   return GSensitivityParameterName(g - kGOffset);
 }
 
-/// The six per-axis problems (accel x, y, z, gyro x, y, z): their parameters (global
-/// indices) and the kind of each regressor.
-struct AxisProblem {
-  enum class Column { kForce, kRate, kOne };
-  std::vector<int> params;
-  std::vector<Column> kinds;
-};
+using detail::AxisProblem;
 
-std::vector<AxisProblem> AxisProblems(bool with_g) {
-  std::vector<AxisProblem> out(6);
-  for (int r = 0; r < 3; ++r) {
-    for (int triad = 0; triad < 2; ++triad) {
-      AxisProblem& a = out[3 * triad + r];
-      const int offset = triad == 0 ? 0 : kGyroOffset;
-      const AxisProblem::Column own = triad == 0 ? AxisProblem::Column::kForce : AxisProblem::Column::kRate;
-      a.params.push_back(offset + r);
-      a.kinds.push_back(own);
-      for (int c = 0; c < 3; ++c) {
-        if (c == r) continue;
-        a.params.push_back(offset + MisalignmentIndex(r, c));
-        a.kinds.push_back(own);
-      }
-      a.params.push_back(offset + 9 + r);
-      a.kinds.push_back(AxisProblem::Column::kOne);
-      if (triad == 1 && with_g) {
-        for (int c = 0; c < 3; ++c) {
-          a.params.push_back(kGOffset + 3 * r + c);
-          a.kinds.push_back(AxisProblem::Column::kForce);
-        }
-      }
-    }
-  }
-  return out;
+/// What a regressor multiplies: the specific force, the rate or one (a bias).
+enum class Column { kForce, kRate, kOne };
+
+Column KindOf(const AxisProblem& axis, int i) {
+  if (axis.regressors.row(i).head<3>().any()) return Column::kForce;
+  if (axis.regressors.row(i).segment<3>(3).any()) return Column::kRate;
+  return Column::kOne;
 }
 
-/// One row of axis problem `a` (0..5) for a measured sample and its truth, weighted by
-/// sqrt(dt): x (regressors) and y (measured minus true mean rate).
-template <typename Vector>
-void AxisRow(int a, const ImuSample& meas, const ImuSample& truth, Vector* x, double* y) {
-  const double dt = truth.dt_s, w = std::sqrt(dt);
-  const Eigen::Vector3d f = truth.dv_b_mps / dt, omega = truth.dtheta_b_rad / dt;
-  const int r = a % 3;
-  const bool gyro = a >= 3;
-  const Eigen::Vector3d& own = gyro ? omega : f;
-  const double measured = (gyro ? meas.dtheta_b_rad(r) : meas.dv_b_mps(r)) / dt;
-  int i = 0;
-  (*x)(i++) = own(r) * w;
-  for (int c = 0; c < 3; ++c) {
-    if (c != r) (*x)(i++) = own(c) * w;
-  }
-  (*x)(i++) = w;
-  for (int c = 0; i < x->size(); ++i, ++c) (*x)(i) = f(c) * w;
-  *y = (measured - own(r)) * w;
+/// An interval's input: z = (f_b, omega_ib_b, 1), the true mean rates.
+using Input = Eigen::Matrix<double, 7, 1>;
+
+/// The model of core/imu_error_model.h over the 33-vector p: the measured mean rates of
+/// accel x, y, z and gyro x, y, z for the input z (G applied only when with_g).
+Eigen::Matrix<double, 6, 1> Measured(const Eigen::Matrix<double, kParameters, 1>& p, bool with_g, const Input& z) {
+  const Eigen::Vector3d f = z.head<3>(), omega = z.segment<3>(3);
+  Eigen::Matrix<double, 6, 1> m;
+  m << MeasuredSpecificForce(p.data(), f), MeasuredRate(p.data() + kGyroOffset, with_g ? p.data() + kGOffset : nullptr, omega, f);
+  return m;
 }
 
 /// Normal equations of one axis problem (all its columns) over one run.
@@ -318,23 +286,6 @@ struct Normal {
   long rows = 0;
 };
 
-Normal Accumulate(int a, int columns, const std::vector<ImuSample>& meas, const std::vector<ImuSample>& truth) {
-  Normal n;
-  n.N = NormalMatrix::Zero(columns, columns);
-  n.b = Regressor::Zero(columns);
-  Regressor x(columns);
-  double y = 0.0;
-  for (std::size_t k = 0; k < meas.size(); ++k) {
-    AxisRow(a, meas[k], truth[k], &x, &y);
-    n.N.noalias() += x * x.transpose();
-    n.b += x * y;
-    n.yy += y * y;
-    n.weight_s += truth[k].dt_s;
-    ++n.rows;
-  }
-  return n;
-}
-
 /// A run prepared for the least squares: its samples within the angle record, the fitted
 /// swing, the truth and the per-axis normal equations.
 struct PreparedRun {
@@ -344,11 +295,35 @@ struct PreparedRun {
   std::vector<Normal> normals;  ///< per axis problem
 };
 
+/// Per axis problem, the normal equations of one run: rows x = regressors z sqrt(dt) and
+/// y = (measured - true mean rate) sqrt(dt), white increment noise having variance ~ dt.
 std::vector<Normal> RunNormals(const std::vector<AxisProblem>& axes, const std::vector<ImuSample>& meas,
                                const std::vector<ImuSample>& truth) {
-  std::vector<Normal> out;
+  std::vector<Normal> out(axes.size());
   for (std::size_t a = 0; a < axes.size(); ++a) {
-    out.push_back(Accumulate(static_cast<int>(a), static_cast<int>(axes[a].params.size()), meas, truth));
+    const Eigen::Index columns = axes[a].regressors.rows();
+    out[a].N = NormalMatrix::Zero(columns, columns);
+    out[a].b = Regressor::Zero(columns);
+  }
+  const Eigen::Matrix<double, kParameters, 1> zero = Eigen::Matrix<double, kParameters, 1>::Zero();
+  Input z;
+  Regressor x;
+  for (std::size_t k = 0; k < meas.size(); ++k) {
+    const double dt = truth[k].dt_s, w = std::sqrt(dt);
+    z << truth[k].dv_b_mps / dt, truth[k].dtheta_b_rad / dt, 1.0;
+    const Eigen::Matrix<double, 6, 1> u = Measured(zero, true, z);  // the truth
+    for (std::size_t a = 0; a < axes.size(); ++a) {
+      const double measured = (a < 3 ? meas[k].dv_b_mps(a) : meas[k].dtheta_b_rad(a - 3)) / dt;
+      const double y = (measured - u(a)) * w;
+      x.noalias() = axes[a].regressors * z;
+      x *= w;
+      Normal& n = out[a];
+      n.N.noalias() += x * x.transpose();
+      n.b += x * y;
+      n.yy += y * y;
+      n.weight_s += dt;
+      ++n.rows;
+    }
   }
   return out;
 }
@@ -393,10 +368,11 @@ std::vector<int> ObservableColumns(const AxisProblem& axis, const Normal& total,
   for (std::size_t j = 0; j < axis.params.size(); ++j) {
     const double rms = std::sqrt(total.N(j, j) / total.weight_s);
     const std::string name = ParameterName(axis.params[j]);
-    if (axis.kinds[j] == AxisProblem::Column::kForce && rms < kMinSpecificForce_mps2) {
+    const Column kind = KindOf(axis, static_cast<int>(j));
+    if (kind == Column::kForce && rms < kMinSpecificForce_mps2) {
       unobservable->push_back(name + ": not excited (no run puts specific force along the axis it multiplies; "
                                      "rms " + std::to_string(rms) + " m/s^2)");
-    } else if (axis.kinds[j] == AxisProblem::Column::kRate && rms < kMinRate_rad_s) {
+    } else if (kind == Column::kRate && rms < kMinRate_rad_s) {
       unobservable->push_back(name + ": not excited (no run turns about the axis it multiplies; rms " +
                               std::to_string(rms) + " rad/s, the Earth rate alone)");
     } else {
@@ -465,6 +441,36 @@ std::string Fixed(double v, int digits) {
 }  // namespace
 
 // ------------------------------------------------------------------ angle file
+
+namespace detail {
+
+std::vector<AxisProblem> AxisProblems(bool with_g) {
+  // Column k < 6 of parameter j's map: the model at (e_j, unit input k) minus at (0, unit
+  // input k), less its constant part (column 6: the model at (e_j, 0) minus at (0, 0)).
+  const int parameters = with_g ? kParameters : kGOffset;
+  const Eigen::Matrix<double, kParameters, 1> zero = Eigen::Matrix<double, kParameters, 1>::Zero();
+  const Input none = Input::Zero();
+  std::vector<AxisProblem> out(6);
+  for (int j = 0; j < parameters; ++j) {
+    const Eigen::Matrix<double, kParameters, 1> unit = Eigen::Matrix<double, kParameters, 1>::Unit(j);
+    Eigen::Matrix<double, 6, 7> map;
+    map.col(6) = Measured(unit, with_g, none) - Measured(zero, with_g, none);
+    for (int k = 0; k < 6; ++k) {
+      const Input e = Input::Unit(k);
+      map.col(k) = Measured(unit, with_g, e) - Measured(zero, with_g, e) - map.col(6);
+    }
+    for (int a = 0; a < 6; ++a) {
+      if (!map.row(a).any()) continue;
+      AxisProblem& axis = out[a];
+      axis.params.push_back(j);
+      axis.regressors.conservativeResize(axis.regressors.rows() + 1, Eigen::NoChange);
+      axis.regressors.bottomRows<1>() = map.row(a);
+    }
+  }
+  return out;
+}
+
+}  // namespace detail
 
 AngleRecord ReadAngleFile(const std::string& path) {
   AngleRecord out;
@@ -635,7 +641,7 @@ ImuCalibrationResult CalibratePendulum(const PendulumData& data, const PendulumO
         "pendulum calibration: no run; the record needs at least one run (the seed uses the "
         "mountings NED, DNE, EDN and one rotated about two axes)");
   }
-  const std::vector<AxisProblem> axes = AxisProblems(options.estimate_g_sensitivity);
+  const std::vector<AxisProblem> axes = detail::AxisProblems(options.estimate_g_sensitivity);
   std::vector<PreparedRun> runs;
   ImuCalibrationResult result;
   for (std::size_t r = 0; r < data.runs.size(); ++r) {

@@ -20,7 +20,8 @@
 //     cos(theta), theta'^2 -- integrated with the ODE by the same RK4.
 //  3. The error model of core/imu_error_model.h is linear in its parameters given the truth:
 //     per axis, y_k - u_k,r = x_k^T p over the mean rates of each interval (increment / dt,
-//     rows weighted by dt: white increment noise has variance proportional to dt). Linear
+//     rows weighted by dt: white increment noise has variance proportional to dt; the rows
+//     are derived from the model itself, detail::AxisProblems below). Linear
 //     least squares per axis (accel: s, two misalignments, bias; gyro: s, two
 //     misalignments, bias, a row of G), covariance s^2 (A^T A)^-1 with the a-posteriori
 //     residual variance s^2 of that axis, plus the swing fits' uncertainty propagated
@@ -118,6 +119,25 @@ struct PendulumOptions {
 /// and c2, no IMU samples within a run's angle record).
 ImuCalibrationResult CalibratePendulum(const PendulumData& data, const PendulumOptions& options = {},
                                        std::vector<SwingFit>* fits = nullptr);
+
+namespace detail {
+
+/// One of the six per-axis linear problems of step 3 (accel x, y, z, gyro x, y, z), derived
+/// from core/imu_error_model.h rather than written out: the model is affine in its
+/// parameters and in (f, omega), so the regressor of parameter j on axis a is
+///   x_j = regressors.row(i) . (f_b, omega_ib_b, 1)   (mean rates, params[i] = j)
+/// with the rows the model evaluated at unit parameter vectors and unit inputs minus the
+/// model at zero parameters. sum_i p(params[i]) x_i is the model (MeasuredSpecificForce /
+/// MeasuredRate) at p minus the truth along axis a.
+struct AxisProblem {
+  std::vector<int> params;  ///< global indices (accel triad, gyro triad, G), ascending
+  Eigen::Matrix<double, Eigen::Dynamic, 7, 0, 7, 7> regressors;
+};
+
+/// The six axis problems; G (the gyro rows' g-sensitivity) only when with_g.
+std::vector<AxisProblem> AxisProblems(bool with_g);
+
+}  // namespace detail
 
 /// Reads a record {latitude_deg, height_m, runs: [{imu, angle, length_m, mounting |
 /// mounting_deg}, ...]} (relative paths against the record's folder; mounting parsed as

@@ -250,6 +250,48 @@ TEST(PendulumCalibrationTest, ShortOrCoarseSwingsAreRefused) {
   EXPECT_THROW(FitSwing(coarse), std::runtime_error);
 }
 
+// ------------------------------------------------------- the shared error model
+
+TEST(PendulumCalibrationTest, AxisRowsAreTheSharedErrorModel) {
+  // The rows of the per-axis least squares (derived from core/imu_error_model.h) times a
+  // random parameter vector reproduce MeasuredSpecificForce / MeasuredRate minus the truth,
+  // every axis, with and without g-sensitivity; every parameter on exactly one axis.
+  sim::Rng rng(42);
+  for (const bool with_g : {true, false}) {
+    const std::vector<detail::AxisProblem> axes = detail::AxisProblems(with_g);
+    ASSERT_EQ(axes.size(), 6u);
+    std::vector<int> count(33, 0);
+    for (const detail::AxisProblem& axis : axes) {
+      ASSERT_EQ(static_cast<std::size_t>(axis.regressors.rows()), axis.params.size());
+      for (const int j : axis.params) ++count[j];
+    }
+    for (int j = 0; j < 33; ++j) EXPECT_EQ(count[j], j < 24 || with_g ? 1 : 0) << j;
+    for (int draw = 0; draw < 20; ++draw) {
+      Eigen::Matrix<double, 33, 1> p;
+      for (int j = 0; j < 33; ++j) p(j) = rng.Normal(1e-2);
+      if (!with_g) p.tail<9>().setZero();
+      Eigen::Vector3d f, omega;
+      for (int i = 0; i < 3; ++i) {
+        f(i) = rng.Normal(10.0);
+        omega(i) = rng.Normal(1.0);
+      }
+      Eigen::Matrix<double, 7, 1> z;
+      z << f, omega, 1.0;
+      Eigen::Matrix<double, 6, 1> model, truth;
+      model << MeasuredSpecificForce(p.data(), f), MeasuredRate(p.data() + 12, with_g ? p.data() + 24 : nullptr, omega, f);
+      truth << f, omega;
+      for (int a = 0; a < 6; ++a) {
+        double rows = 0.0;
+        for (std::size_t i = 0; i < axes[a].params.size(); ++i) {
+          rows += p(axes[a].params[i]) * axes[a].regressors.row(static_cast<Eigen::Index>(i)).dot(z);
+        }
+        // model - truth is computed from values ~|model|: rounding eps |model| ~ 1e-15 of it.
+        EXPECT_NEAR(rows, model(a) - truth(a), 1e-12 * std::fabs(model(a))) << "axis " << a << " with_g " << with_g;
+      }
+    }
+  }
+}
+
 // ------------------------------------------------------------------ calibration
 
 TEST(PendulumCalibrationTest, RecoversKnownErrorsFromTheFourMountings) {
