@@ -71,6 +71,21 @@ class AngleEncoder {
   double noise_rad_ = 0.0, quantum_rad_ = 0.0;
 };
 
+/// The IMU's temperature sensor: the profile's temperature at the sample's truth time,
+/// tagged with the IMU sample's time tag; temperature.csv.
+class TemperatureSensor {
+ public:
+  TemperatureSensor(const TemperatureProfile& profile, const std::string& path) : profile_(profile), file_(path) {
+    file_.stream() << "t_s,temperature_degC\n";
+  }
+  void Write(double t_s, double truth_t_s) { file_.stream() << t_s << ',' << profile_.At(truth_t_s) << '\n'; }
+  void Commit() { file_.Commit(); }
+
+ private:
+  const TemperatureProfile& profile_;
+  AtomicFile file_;
+};
+
 }  // namespace
 
 SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& options,
@@ -120,6 +135,12 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
     angle_out = std::make_unique<AngleEncoder>(*rig, rng.Stream("angle"), perfect, path("angle.csv"));
   }
 
+  std::unique_ptr<TemperatureSensor> temperature_out;
+  const TemperatureProfile& profile = scenario.imu.errors.temperature;
+  if (profile.initial_degC != profile.final_degC) {
+    temperature_out = std::make_unique<TemperatureSensor>(profile, path("temperature.csv"));
+  }
+
   const long n = std::lround(scenario.duration_s * imu.internal_rate_hz());
   const long progress_step = std::max(1L, n / 20);
   for (long k = 0; k <= n; ++k) {
@@ -132,6 +153,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
       imu_out.Write(*s);
       truth_out.Write(t.state);
       if (angle_out) angle_out->Write(s->t_s, t.t_s);
+      if (temperature_out) temperature_out->Write(s->t_s, t.t_s);
       ++report.imu_samples;
     }
     PushAndWrite(gnss.get(), gnss_out.get(), t, &report.gnss_samples);
@@ -183,6 +205,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
   truth_out.Commit();
   init_out.Commit();
   if (angle_out) angle_out->Commit();
+  if (temperature_out) temperature_out->Commit();
   if (gnss_out) gnss_out->Commit();
   if (mag_out) mag_out->Commit();
   if (baro_out) baro_out->Commit();

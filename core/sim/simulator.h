@@ -8,6 +8,9 @@
 //   master.nav KF-GINS navigation format, delivered late        when it has master
 //   angle.csv  t_s,theta_rad: the pivot encoder, one reading per IMU sample (its time tag),
 //              the angle at that sample's truth time              when it is a pendulum rig
+//   temperature.csv t_s,temperature_degC: the IMU's temperature sensor, one reading per
+//              IMU sample (its time tag), the profile at that sample's truth time
+//                                             when imu.errors.temperature_profile is not constant
 //   errors.yaml every drawn error value, with units in the keys, and the seed
 // All files appear whole or not at all. Times start at 0 s (GPS week 0).
 #pragma once

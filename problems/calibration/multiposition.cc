@@ -186,10 +186,10 @@ Residuals BuildResiduals(const MultiPositionData& data, const MultiPositionOptio
       ss_g += (imu[i].dtheta_b_rad / imu[i].dt_s - h.omega_mean_b).cwiseAbs2();
     }
     dof += h.used - 1;
-    const Eigen::Vector3d& e = intervals[j].euler_rad;
-    h.R_n_b = DcmFromEuler(e.x(), e.y(), e.z());
-    h.f_true_b = -h.R_n_b.transpose() * g_n;  // at rest f_n = -g_n
-    h.omega_true_b = h.R_n_b.transpose() * omega_ie_n;
+    const StaticTruth truth = StaticTruthAt(intervals[j].euler_rad, data.latitude_rad, data.height_m);
+    h.R_n_b = truth.R_n_b;
+    h.f_true_b = truth.f_b_mps2;
+    h.omega_true_b = truth.omega_ib_b_rad_per_s;
     res.holds.push_back(h);
   }
   if (saturated_total > 0) {
@@ -447,6 +447,15 @@ std::vector<const Measurement*> Pointers(const Residuals& res) {
 }
 
 }  // namespace
+
+StaticTruth StaticTruthAt(const Eigen::Vector3d& euler_rad, double latitude_rad, double height_m) {
+  StaticTruth truth;
+  truth.R_n_b = DcmFromEuler(euler_rad.x(), euler_rad.y(), euler_rad.z());
+  const Eigen::Vector3d g_n(0.0, 0.0, wgs84::NormalGravity(latitude_rad, height_m));
+  truth.f_b_mps2 = -truth.R_n_b.transpose() * g_n;  // at rest f_n = -g_n
+  truth.omega_ib_b_rad_per_s = truth.R_n_b.transpose() * wgs84::EarthRateNed(latitude_rad);
+  return truth;
+}
 
 // ------------------------------------------------------------------------ batch
 

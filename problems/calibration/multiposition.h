@@ -43,6 +43,15 @@ struct MultiPositionOptions {
   double gyro_saturation_rad_per_s = 0.0;
 };
 
+/// The truth of an IMU at rest on the table at the attitude euler_rad (roll, pitch, yaw of
+/// R_n_b): f_b = -R_b_n g_n (normal gravity at the site) and omega_ib_b = R_b_n omega_ie_n.
+struct StaticTruth {
+  Eigen::Matrix3d R_n_b;
+  Eigen::Vector3d f_b_mps2;
+  Eigen::Vector3d omega_ib_b_rad_per_s;
+};
+StaticTruth StaticTruthAt(const Eigen::Vector3d& euler_rad, double latitude_rad, double height_m);
+
 /// Batch calibration. Throws std::runtime_error naming what is missing (fewer than 6
 /// positions, no usable samples in a hold, ...).
 ImuCalibrationResult CalibrateMultiPosition(const MultiPositionData& data, const MultiPositionOptions& options = {});

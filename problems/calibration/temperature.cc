@@ -12,9 +12,12 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
 #include "core/io/input_error.h"
+#include "core/io/text_reader.h"
+#include "core/sim/calibration_rig.h"
 #include "core/sim/yaml_config.h"
 
 namespace navtwin::calibration {
@@ -30,6 +33,10 @@ constexpr double kMaxRecordTemperatureDegC = 200.0;
 /// than this many standard deviations of a chi-square (sqrt(2 dof)) is flagged in the notes:
 /// the runs disagree beyond their sigma, i.e. the parameter seems to depend on temperature.
 constexpr double kChiSquareFlagSigmas = 5.0;
+/// Record bounds of segment_s: below 0.1 s a segment holds a handful of samples, above an
+/// hour a warm-up has ended within one segment.
+constexpr double kMinSegmentS = 0.1;
+constexpr double kMaxSegmentS = 3600.0;
 
 std::string Num(double v, int precision = 4) {
   std::ostringstream s;
@@ -375,10 +382,391 @@ TemperatureCalibration CalibrateTemperature(const std::vector<TemperatureRun>& r
   return out;
 }
 
-std::vector<TemperatureRun> ReadTemperatureRuns(const std::string& record_path,
-                                                TemperatureCalibrationOptions* options) {
+// ------------------------------------------------------------------------ warm-up
+
+namespace {
+
+/// A direction of the column-normalised normal matrix with a relative eigenvalue below
+/// this cannot be separated (condition number 1e10), as in multiposition.cc.
+constexpr double kWarmUpNullEigenvalueRatio = 1e-10;
+
+/// One column of an axis's least squares: the parameter and the power of dT it carries.
+struct Unknown {
+  std::string name;
+  int power = 0;  ///< k of dT^k in the column (0: none)
+};
+
+/// The weighted linear least squares of one sensor axis over all segments:
+/// y = A x + e, var e_i = s0^2 / w_i, with A's dT^k columns in u = dT / scale.
+struct AxisFit {
+  std::string label;  ///< e.g. "accel x"
+  std::vector<Unknown> unknowns;
+  Eigen::MatrixXd A;
+  Eigen::VectorXd y, w;
+  Eigen::VectorXd x;           ///< in the parameters' own units (dT^k unscaled)
+  Eigen::MatrixXd covariance;  ///< s0^2 N^-1, same units
+  Eigen::VectorXd residual;
+  double variance_factor = 1.0;
+};
+
+void SolveAxis(AxisFit* fit, double scale, const std::string& what) {
+  const int m = static_cast<int>(fit->A.rows());
+  const int p = static_cast<int>(fit->A.cols());
+  if (m <= p) {
+    throw std::runtime_error(what + ": " + fit->label + " has " + std::to_string(p) + " unknowns but only " +
+                             std::to_string(m) + " segments; use longer holds, more positions or a shorter segment_s");
+  }
+  const Eigen::VectorXd sqrt_w = fit->w.cwiseSqrt();
+  const Eigen::MatrixXd A_w = sqrt_w.asDiagonal() * fit->A;
+  const Eigen::VectorXd y_w = sqrt_w.cwiseProduct(fit->y);
+  // A column without signal: nothing excites that parameter (e.g. no gravity on an axis).
+  const Eigen::VectorXd norms = A_w.colwise().norm();
+  for (int j = 0; j < p; ++j) {
+    if (!(norms(j) > 0.0)) {
+      throw std::runtime_error(what + ": " + fit->unknowns[j].name +
+                               " cannot be estimated: no position puts gravity on the axis it multiplies");
+    }
+  }
+  // Directions the positions and temperatures cannot separate.
+  const Eigen::MatrixXd A_n = A_w * norms.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A_n.transpose() * A_n);
+  if (eig.eigenvalues()(0) < kWarmUpNullEigenvalueRatio * eig.eigenvalues().maxCoeff()) {
+    const Eigen::VectorXd v = eig.eigenvectors().col(0);
+    const double vmax = v.cwiseAbs().maxCoeff();
+    std::string names;
+    for (int j = 0; j < p; ++j) {
+      if (std::abs(v(j)) > 0.1 * vmax) names += (names.empty() ? "" : ", ") + fit->unknowns[j].name;
+    }
+    throw std::runtime_error(what + ": " + names +
+                             " cannot be separated with these positions and temperatures; hold every axis at "
+                             "+1 g and -1 g at several temperatures while the IMU warms up");
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(A_w);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd R_inv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::VectorXd x_scaled = qr.solve(y_w);
+  fit->residual = fit->y - fit->A * x_scaled;
+  fit->variance_factor = fit->residual.cwiseAbs2().dot(fit->w) / (m - p);
+  Eigen::VectorXd unscale(p);
+  for (int j = 0; j < p; ++j) unscale(j) = std::pow(scale, -fit->unknowns[j].power);
+  fit->x = unscale.cwiseProduct(x_scaled);
+  fit->covariance = fit->variance_factor * unscale.asDiagonal() * (R_inv * R_inv.transpose()) * unscale.asDiagonal();
+}
+
+/// The segments of one run's static holds.
+void CutSegments(const WarmUpRun& run, int run_index, const TemperatureCalibrationOptions& options,
+                 const std::string& what, std::vector<WarmUpSegment>* segments, int* positions) {
+  const MultiPositionData& data = run.data;
+  const std::string label = "run " + std::to_string(run_index) + " (" +
+                            (data.imu_path.empty() ? std::string("the IMU data") : data.imu_path) + ")";
+  const sim::MultiPositionRig rig(data.schedule);
+  const std::vector<sim::StaticInterval>& intervals = rig.static_intervals();
+  constexpr int kMinPositions = 6;  // as the multi-position calibration: 12 accelerometer unknowns
+  if (static_cast<int>(intervals.size()) < kMinPositions) {
+    throw std::runtime_error(what + ": " + label + ": the schedule has " + std::to_string(intervals.size()) +
+                             " static positions; at least " + std::to_string(kMinPositions) + " are needed");
+  }
+  const TemperatureSeries& temp = run.temperature;
+  if (temp.t_s.empty() || temp.t_s.size() != temp.temperature_degC.size()) {
+    throw std::runtime_error(what + ": " + label + ": no temperature readings" +
+                             (temp.path.empty() ? std::string() : " in " + temp.path));
+  }
+  const std::vector<ImuSample>& imu = data.imu;
+  constexpr double kEps_s = 1e-9;
+  const double settle_s = options.multiposition.settle_s;
+  for (std::size_t j = 0; j < intervals.size(); ++j) {
+    const double h0 = intervals[j].start_s + settle_s, h1 = intervals[j].end_s - settle_s;
+    const std::string where = label + ": position " + std::to_string(j + 1) + " (hold " +
+                              Num(intervals[j].start_s, 6) + " to " + Num(intervals[j].end_s, 6) + " s)";
+    if (!(h1 > h0)) throw std::runtime_error(what + ": " + where + " is not longer than twice settle_s");
+    const StaticTruth truth = StaticTruthAt(intervals[j].euler_rad, data.latitude_rad, data.height_m);
+    const int n_seg = std::max(1, static_cast<int>(std::floor((h1 - h0) / options.segment_s + 1e-9)));
+    const double len = (h1 - h0) / n_seg;
+    for (int k = 0; k < n_seg; ++k) {
+      WarmUpSegment seg;
+      seg.run = run_index;
+      seg.position = static_cast<int>(j);
+      seg.t0_s = h0 + k * len;
+      seg.t1_s = h0 + (k + 1) * len;
+      const auto begin = std::partition_point(imu.begin(), imu.end(), [&seg](const ImuSample& s) {
+        return s.t_s - s.dt_s < seg.t0_s - kEps_s;
+      });
+      const auto end =
+          std::partition_point(begin, imu.end(), [&seg](const ImuSample& s) { return s.t_s <= seg.t1_s + kEps_s; });
+      Eigen::Vector3d dv = Eigen::Vector3d::Zero(), dth = Eigen::Vector3d::Zero();
+      for (auto it = begin; it != end; ++it) {
+        dv += it->dv_b_mps;
+        dth += it->dtheta_b_rad;
+        seg.duration_s += it->dt_s;
+      }
+      if (!(seg.duration_s > 0.0)) {
+        throw std::runtime_error(what + ": no IMU samples in " + where + " between " + Num(seg.t0_s, 6) + " and " +
+                                 Num(seg.t1_s, 6) + " s");
+      }
+      seg.f_mean_b_mps2 = dv / seg.duration_s;
+      seg.omega_mean_b_rad_per_s = dth / seg.duration_s;
+      seg.f_true_b_mps2 = truth.f_b_mps2;
+      seg.omega_true_b_rad_per_s = truth.omega_ib_b_rad_per_s;
+      // Temperature: the mean of the readings within, else interpolated at the middle.
+      const auto t_begin = std::lower_bound(temp.t_s.begin(), temp.t_s.end(), seg.t0_s);
+      const auto t_end = std::upper_bound(t_begin, temp.t_s.end(), seg.t1_s);
+      if (t_begin != t_end) {
+        double sum = 0.0;
+        for (auto it = t_begin; it != t_end; ++it) sum += temp.temperature_degC[it - temp.t_s.begin()];
+        seg.temperature_degC = sum / static_cast<double>(t_end - t_begin);
+      } else {
+        const double t_mid = 0.5 * (seg.t0_s + seg.t1_s);
+        if (t_begin == temp.t_s.begin() || t_begin == temp.t_s.end()) {
+          throw std::runtime_error(what + ": the temperature file " + temp.path + " (" + Num(temp.t_s.front(), 6) +
+                                   " to " + Num(temp.t_s.back(), 6) + " s) does not cover " + where);
+        }
+        const std::size_t b = static_cast<std::size_t>(t_begin - temp.t_s.begin()), a = b - 1;
+        const double f = (t_mid - temp.t_s[a]) / (temp.t_s[b] - temp.t_s[a]);
+        seg.temperature_degC = temp.temperature_degC[a] + f * (temp.temperature_degC[b] - temp.temperature_degC[a]);
+      }
+      segments->push_back(seg);
+    }
+    ++*positions;
+  }
+}
+
+}  // namespace
+
+WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const TemperatureCalibrationOptions& options) {
+  const std::string what = "warm-up temperature calibration";
+  if (options.order < 1) {
+    throw std::runtime_error(what + ": the polynomial order must be >= 1, got " + std::to_string(options.order));
+  }
+  if (!(options.segment_s > 0.0) || !std::isfinite(options.segment_s)) {
+    throw std::runtime_error(what + ": segment_s must be finite and > 0, got " + Num(options.segment_s));
+  }
+  if (runs.empty()) throw std::runtime_error(what + ": no runs");
+  WarmUpCalibration out;
+  int positions = 0;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    CutSegments(runs[r], static_cast<int>(r), options, what, &out.segments, &positions);
+  }
+  const std::vector<WarmUpSegment>& segments = out.segments;
+  const int m = static_cast<int>(segments.size());
+  std::vector<double> temperatures;
+  for (const WarmUpSegment& seg : segments) temperatures.push_back(seg.temperature_degC);
+  CheckTemperatureCoverage(temperatures, options.order, options.min_span_per_order_degC,
+                           what + " (mean temperatures of the " + std::to_string(m) + " segments)");
+  double reference_degC = 0.0;
+  if (options.reference_degC) {
+    reference_degC = *options.reference_degC;
+    if (!std::isfinite(reference_degC)) throw std::runtime_error(what + ": the reference temperature is not finite");
+  } else {
+    for (double t : temperatures) reference_degC += t;
+    reference_degC /= m;
+  }
+  double scale = 0.0;
+  for (double t : temperatures) scale = std::max(scale, std::abs(t - reference_degC));
+
+  // One least squares per axis: the axes share no unknown (white noise independent per axis).
+  const int order = options.order;
+  const bool estimate_g = options.multiposition.estimate_g_sensitivity;
+  std::vector<AxisFit> fits;
+  for (int i = 0; i < 3; ++i) {
+    AxisFit a;
+    a.label = std::string("accel ") + "xyz"[i];
+    a.unknowns.push_back({TriadParameterName("accel", i), 0});
+    for (int j = 0; j < 3; ++j) {
+      if (j != i) a.unknowns.push_back({TriadParameterName("accel", MisalignmentIndex(i, j)), 0});
+    }
+    a.unknowns.push_back({TriadParameterName("accel", 9 + i), 0});
+    for (int k = 1; k <= order; ++k) a.unknowns.push_back({TriadParameterName("accel", i) + ".dT" + std::to_string(k), k});
+    for (int k = 1; k <= order; ++k) {
+      a.unknowns.push_back({TriadParameterName("accel", 9 + i) + ".dT" + std::to_string(k), k});
+    }
+    AxisFit g;
+    g.label = std::string("gyro ") + "xyz"[i];
+    g.unknowns.push_back({TriadParameterName("gyro", 9 + i), 0});
+    for (int k = 1; k <= order; ++k) {
+      g.unknowns.push_back({TriadParameterName("gyro", 9 + i) + ".dT" + std::to_string(k), k});
+    }
+    if (estimate_g) {
+      for (int j = 0; j < 3; ++j) g.unknowns.push_back({GSensitivityParameterName(3 * i + j), 0});
+    }
+    for (AxisFit* fit : {&a, &g}) {
+      fit->A.resize(m, static_cast<Eigen::Index>(fit->unknowns.size()));
+      fit->y.resize(m);
+      fit->w.resize(m);
+    }
+    for (int s = 0; s < m; ++s) {
+      const WarmUpSegment& seg = segments[s];
+      const Eigen::Vector3d& f = seg.f_true_b_mps2;
+      const double u = scale > 0.0 ? (seg.temperature_degC - reference_degC) / scale : 0.0;
+      int c = 0;
+      a.A(s, c++) = f(i);
+      for (int j = 0; j < 3; ++j) {
+        if (j != i) a.A(s, c++) = f(j);
+      }
+      a.A(s, c++) = 1.0;
+      for (int k = 1; k <= order; ++k) a.A(s, c++) = std::pow(u, k) * f(i);
+      for (int k = 1; k <= order; ++k) a.A(s, c++) = std::pow(u, k);
+      a.y(s) = seg.f_mean_b_mps2(i) - f(i);
+      c = 0;
+      g.A(s, c++) = 1.0;
+      for (int k = 1; k <= order; ++k) g.A(s, c++) = std::pow(u, k);
+      if (estimate_g) {
+        for (int j = 0; j < 3; ++j) g.A(s, c++) = f(j);
+      }
+      g.y(s) = seg.omega_mean_b_rad_per_s(i) - seg.omega_true_b_rad_per_s(i);
+      a.w(s) = g.w(s) = seg.duration_s;
+    }
+    fits.push_back(std::move(a));
+    fits.push_back(std::move(g));
+  }
+  for (AxisFit& fit : fits) SolveAxis(&fit, scale > 0.0 ? scale : 1.0, what);
+
+  // Where each parameter lives: (fit, column).
+  const auto locate = [&fits](const std::string& name) -> std::pair<int, int> {
+    for (std::size_t f = 0; f < fits.size(); ++f) {
+      for (std::size_t j = 0; j < fits[f].unknowns.size(); ++j) {
+        if (fits[f].unknowns[j].name == name) return {static_cast<int>(f), static_cast<int>(j)};
+      }
+    }
+    return {-1, -1};
+  };
+
+  ImuCalibrationResult& result = out.result;
+  ImuCalibration& cal = result.calibration;
+  Eigen::Matrix<double, kTriadParameters, 1> gyro_sigma, accel_sigma;
+  Eigen::Matrix<double, kGSensitivityParameters, 1> g_sigma;
+  gyro_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
+  accel_sigma = gyro_sigma;
+  g_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
+  TemperatureTerms terms;
+  terms.reference_degC = reference_degC;
+  for (int k = 1; k <= order; ++k) {
+    terms.gyro_bias_rad_per_s.push_back(Eigen::Vector3d::Zero());
+    terms.gyro_scale_factor.push_back(Eigen::Vector3d::Zero());
+    terms.accel_bias_mps2.push_back(Eigen::Vector3d::Zero());
+    terms.accel_scale_factor.push_back(Eigen::Vector3d::Zero());
+  }
+  // Outputs in the chamber path's order: gyro block, accel block, g-sensitivity; each
+  // temperature-dependent parameter followed by its .dT<k>.
+  std::vector<std::pair<int, int>> where;
+  const auto add = [&](const std::string& name) {
+    const std::pair<int, int> loc = locate(name);
+    if (loc.first < 0) return false;
+    where.push_back(loc);
+    result.estimated.push_back(name);
+    return true;
+  };
+  for (const char* triad : {"gyro", "accel"}) {
+    const bool gyro = std::string(triad) == "gyro";
+    for (int idx = 0; idx < kTriadParameters; ++idx) {
+      const std::string name = TriadParameterName(triad, idx);
+      if (!add(name)) {
+        result.unobservable.push_back(name + ": not estimated from warm-up data (the static holds see only the "
+                                             "Earth rate; the gyro scale factor and misalignment need rotations)");
+        continue;
+      }
+      const auto [f, j] = where.back();
+      (gyro ? cal.gyro : cal.accel)(idx) = fits[f].x(j);
+      (gyro ? gyro_sigma : accel_sigma)(idx) = std::sqrt(fits[f].covariance(j, j));
+      if (!IsTemperatureDependent(idx)) continue;
+      const int axis = idx < 3 ? idx : idx - 9;
+      for (int k = 1; k <= order; ++k) {
+        if (!add(name + ".dT" + std::to_string(k))) continue;
+        const double c = fits[where.back().first].x(where.back().second);
+        if (gyro) {
+          (idx < 3 ? terms.gyro_scale_factor : terms.gyro_bias_rad_per_s)[k - 1](axis) = c;
+        } else {
+          (idx < 3 ? terms.accel_scale_factor : terms.accel_bias_mps2)[k - 1](axis) = c;
+        }
+      }
+    }
+  }
+  for (int idx = 0; idx < kGSensitivityParameters && estimate_g; ++idx) {
+    add(GSensitivityParameterName(idx));
+    const auto [f, j] = where.back();
+    cal.g_sensitivity(idx) = fits[f].x(j);
+    g_sigma(idx) = std::sqrt(fits[f].covariance(j, j));
+  }
+  cal.gyro_sigma = gyro_sigma;
+  cal.accel_sigma = accel_sigma;
+  if (estimate_g) cal.g_sensitivity_sigma = g_sigma;
+  cal.temperature = terms;
+  // Axes are independent least squares: covariance blocks between them are 0.
+  const int n_out = static_cast<int>(where.size());
+  result.covariance = Eigen::MatrixXd::Zero(n_out, n_out);
+  for (int a = 0; a < n_out; ++a) {
+    for (int b = 0; b < n_out; ++b) {
+      if (where[a].first == where[b].first) {
+        result.covariance(a, b) = fits[where[a].first].covariance(where[a].second, where[b].second);
+      }
+    }
+  }
+
+  double accel_ss = 0.0, gyro_ss = 0.0;
+  for (const AxisFit& fit : fits) (fit.label[0] == 'a' ? accel_ss : gyro_ss) += fit.residual.squaredNorm();
+  result.accel_residual_rms_mps2 = std::sqrt(accel_ss / (3.0 * m));
+  result.gyro_residual_rms_rad_per_s = std::sqrt(gyro_ss / (3.0 * m));
+  result.positions = positions;
+  const auto [t_min, t_max] = std::minmax_element(temperatures.begin(), temperatures.end());
+  result.notes.push_back(std::to_string(runs.size()) + " warm-up run(s), " + std::to_string(positions) +
+                         " static positions cut into " + std::to_string(m) + " segments (segment_s " +
+                         Num(options.segment_s) + " s) at " + Num(*t_min) + " .. " + Num(*t_max) + " degC; order " +
+                         std::to_string(order) + " in dT = T - " + Num(reference_degC) + " degC");
+  for (const AxisFit& fit : fits) {
+    // With weights in seconds, the a-posteriori sigma is the noise of a 1 s mean.
+    result.notes.push_back(fit.label + ": noise of a 1 s mean " + Num(std::sqrt(fit.variance_factor)) +
+                           (fit.label[0] == 'a' ? " m/s^2" : " rad/s") + " (a posteriori, " +
+                           std::to_string(m - static_cast<int>(fit.unknowns.size())) + " dof)");
+  }
+  return out;
+}
+
+TemperatureSeries ReadTemperatureFile(const std::string& path) {
+  TemperatureSeries out;
+  out.path = path;
+  LineReader lines(path);
+  std::string line;
+  std::vector<std::string_view> fields;
+  HeaderColumns header;
+  UnitColumn time;
+  int temperature = -1;
+  bool have_header = false;
+  IncreasingTime monotonic;
+  while (lines.Next(&line)) {
+    if (IsBlank(line)) continue;
+    if (!have_header) {
+      if (Trim(line).front() == '#') continue;
+      SplitCsv(line, &fields);
+      header = HeaderColumns(fields, path, lines.line_number());
+      time = header.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
+      temperature = header.Require("temperature_degC");
+      have_header = true;
+      continue;
+    }
+    SplitCsv(line, &fields);
+    RequireFieldCount(fields.size(), header.size(), path, lines.line_number());
+    const double t = ParseDouble(fields[static_cast<std::size_t>(time.index)], path, lines.line_number(), time.name) *
+                     time.scale;
+    monotonic.Check(t, path, lines.line_number(), time.name);
+    const double T = ParseDouble(fields[static_cast<std::size_t>(temperature)], path, lines.line_number(),
+                                 "temperature_degC");
+    if (T < kMinRecordTemperatureDegC || T > kMaxRecordTemperatureDegC) {
+      throw InputError(path, lines.line_number(), "temperature_degC",
+                       "must be within [" + Num(kMinRecordTemperatureDegC) + ", " + Num(kMaxRecordTemperatureDegC) +
+                           "] degC, got " + Num(T));
+    }
+    out.t_s.push_back(t);
+    out.temperature_degC.push_back(T);
+  }
+  if (!have_header) throw InputError(path, 0, "", "no samples (the file is empty)");
+  if (out.t_s.empty()) throw InputError(path, 0, "", "no samples (only a header)");
+  return out;
+}
+
+TemperatureRecord ReadTemperatureRecord(const std::string& record_path) {
+  TemperatureRecord record;
+  TemperatureCalibrationOptions* options = &record.options;
   const sim::ConfigNode root = sim::LoadYamlFile(record_path);
-  root.RequireKeys({"order", "latitude_deg", "height_m", "reference_degC", "runs"});
+  root.RequireKeys({"order", "latitude_deg", "height_m", "reference_degC", "segment_s", "runs"});
   options->order = root.Int("order", 2, 1, kMaxOrder);
   if (!root.Has("latitude_deg")) root.Fail("latitude_deg", "missing (the latitude of the chamber, deg)");
   root.Double("latitude_deg", 0.0, -90.0, 90.0);
@@ -387,18 +775,26 @@ std::vector<TemperatureRun> ReadTemperatureRuns(const std::string& record_path,
     options->reference_degC =
         root.Double("reference_degC", 0.0, kMinRecordTemperatureDegC, kMaxRecordTemperatureDegC);
   }
+  options->segment_s = root.Double("segment_s", options->segment_s, kMinSegmentS, kMaxSegmentS);
   if (!root.Has("runs")) root.Fail("runs", "missing (a list of {temperature_degC, imu, trajectory})");
   const std::vector<sim::ConfigNode> run_nodes = root.Elements("runs");
   if (run_nodes.empty()) root.Fail("runs", "the list is empty");
   const std::string base_dir = std::filesystem::path(record_path).parent_path().string();
 
-  std::vector<TemperatureRun> runs;
   for (const sim::ConfigNode& node : run_nodes) {
-    node.RequireKeys({"temperature_degC", "imu", "trajectory"});
-    TemperatureRun run;
-    if (!node.Has("temperature_degC")) node.Fail("temperature_degC", "missing (the soak temperature, degC)");
-    run.temperature_degC =
-        node.Double("temperature_degC", 0.0, kMinRecordTemperatureDegC, kMaxRecordTemperatureDegC);
+    node.RequireKeys({"temperature_degC", "temperature", "imu", "trajectory"});
+    const bool warm_up = node.Has("temperature");
+    if (warm_up && node.Has("temperature_degC")) {
+      node.Fail("temperature", "give temperature_degC (a chamber soak) or temperature (a warm-up file), not both");
+    }
+    if (!warm_up && !node.Has("temperature_degC")) {
+      node.Fail("temperature_degC", "missing (the soak temperature, degC; or temperature: FILE for a warm-up)");
+    }
+    if ((warm_up && !record.chamber.empty()) || (!warm_up && !record.warm_up.empty())) {
+      node.Fail(warm_up ? "temperature" : "temperature_degC",
+                "the record mixes chamber runs (temperature_degC) and warm-up runs (temperature: FILE); "
+                "calibrate them as two records");
+    }
     // The multi-position reader takes {imu, latitude_deg, height_m, trajectory}: the run's
     // own keys plus the record's site (the nodes keep their lines for messages).
     YAML::Node merged(YAML::NodeType::Map);
@@ -408,16 +804,33 @@ std::vector<TemperatureRun> ReadTemperatureRuns(const std::string& record_path,
     for (const char* key : {"latitude_deg", "height_m"}) {
       if (root.Has(key)) merged[key] = root.yaml()[key];
     }
-    run.data = ReadMultiPositionData(sim::ConfigNode(merged, node.file(), node.path()), base_dir);
-    runs.push_back(std::move(run));
+    if (warm_up) {
+      WarmUpRun run;
+      const std::string file = node.String("temperature", "");
+      if (file.empty()) node.Fail("temperature", "must name the temperature file (t_s,temperature_degC)");
+      std::filesystem::path p(file);
+      if (p.is_relative() && !base_dir.empty()) p = std::filesystem::path(base_dir) / p;
+      run.temperature = ReadTemperatureFile(p.string());
+      run.data = ReadMultiPositionData(sim::ConfigNode(merged, node.file(), node.path()), base_dir);
+      record.warm_up.push_back(std::move(run));
+    } else {
+      TemperatureRun run;
+      run.temperature_degC =
+          node.Double("temperature_degC", 0.0, kMinRecordTemperatureDegC, kMaxRecordTemperatureDegC);
+      run.data = ReadMultiPositionData(sim::ConfigNode(merged, node.file(), node.path()), base_dir);
+      record.chamber.push_back(std::move(run));
+    }
   }
-  return runs;
+  if (!record.chamber.empty() && root.Has("segment_s")) {
+    root.Fail("segment_s", "applies to warm-up runs (temperature: FILE) only");
+  }
+  return record;
 }
 
 ImuCalibrationResult CalibrateTemperatureRecord(const std::string& record_path) {
-  TemperatureCalibrationOptions options;
-  const std::vector<TemperatureRun> runs = ReadTemperatureRuns(record_path, &options);
-  return CalibrateTemperature(runs, options).result;
+  const TemperatureRecord record = ReadTemperatureRecord(record_path);
+  if (!record.warm_up.empty()) return CalibrateWarmUp(record.warm_up, record.options).result;
+  return CalibrateTemperature(record.chamber, record.options).result;
 }
 
 }  // namespace navtwin::calibration

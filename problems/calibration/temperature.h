@@ -14,6 +14,15 @@
 //      whose chi-square tests that independence).
 // Every output is a linear combination of the runs' estimates, so the full covariance of
 // the outputs follows from the runs' covariances (runs independent).
+//
+// Warm-up data (CalibrateWarmUp): runs whose temperature drifts (the IMU's self-heating
+// after switch-on), each a multi-position schedule with the IMU temperature sensor's file.
+// Every static hold is cut into segments of segment_s at their mean temperature, and one
+// linear least squares over all segments of all runs fits the static model with the
+// temperature polynomials inside it (docs/calibration-temperature.md "Warm-up data"):
+//   f_m     = (K_a0 + diag(sum_k c_k dT^k)) f + b_a0 + sum_k d_k dT^k
+//   omega_m = omega + G f + b_g0 + sum_k e_k dT^k
+// (the gyro scale factor and misalignment need rotations: not estimated from the holds).
 #pragma once
 
 #include <optional>
@@ -80,6 +89,8 @@ struct TemperatureCalibrationOptions {
   /// dT = T - reference; default: the mean of the run temperatures.
   std::optional<double> reference_degC;
   double min_span_per_order_degC = kMinSpanPerOrderDegC;
+  /// Warm-up data only: the length of the segments each static hold is cut into (s, > 0).
+  double segment_s = 10.0;
   MultiPositionOptions multiposition;
 };
 
@@ -107,9 +118,59 @@ struct TemperatureCalibration {
 TemperatureCalibration CalibrateTemperature(const std::vector<TemperatureRun>& runs,
                                             const TemperatureCalibrationOptions& options = {});
 
+/// The IMU temperature sensor's readings along a run (a temperature.csv).
+struct TemperatureSeries {
+  std::vector<double> t_s;  ///< strictly increasing, on the IMU's time scale
+  std::vector<double> temperature_degC;
+  std::string path;  ///< for messages
+};
+
+/// Reads t_s,temperature_degC (CSV with a header; also t_ms). Throws InputError naming the
+/// file, line and field for a missing column, a value that is not a finite number, time
+/// that does not increase, or a file without samples.
+TemperatureSeries ReadTemperatureFile(const std::string& path);
+
+/// One warm-up run: a multi-position schedule during which the temperature drifts.
+struct WarmUpRun {
+  MultiPositionData data;
+  TemperatureSeries temperature;
+};
+
+/// One segment of a static hold: the means the least squares uses.
+struct WarmUpSegment {
+  int run = 0;
+  int position = 0;            ///< 0-based hold of the run's schedule
+  double t0_s = 0.0, t1_s = 0.0;
+  double duration_s = 0.0;     ///< sum of the samples' dt (the weight)
+  double temperature_degC = 0.0;  ///< mean of the readings within (interpolated if none)
+  Eigen::Vector3d f_true_b_mps2, omega_true_b_rad_per_s;
+  Eigen::Vector3d f_mean_b_mps2, omega_mean_b_rad_per_s;
+};
+
+struct WarmUpCalibration {
+  /// The same layout as TemperatureCalibration::result: constant blocks at the reference,
+  /// `temperature` the coefficients k >= 1, "<name>.dT<k>" in `estimated`.
+  ImuCalibrationResult result;
+  std::vector<WarmUpSegment> segments;
+};
+
+/// The warm-up calibration. Throws std::runtime_error for a schedule with fewer than 6
+/// static positions, a hold without IMU samples or outside the temperature file, too few
+/// distinct segment temperatures or too small a span for the order, fewer segments than
+/// unknowns, and parameters the positions and temperatures cannot separate (naming them).
+WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const TemperatureCalibrationOptions& options = {});
+
+/// A temperature record: chamber runs (temperature_degC) or warm-up runs (temperature:
+/// FILE), never both.
+struct TemperatureRecord {
+  TemperatureCalibrationOptions options;
+  std::vector<TemperatureRun> chamber;
+  std::vector<WarmUpRun> warm_up;
+};
+
 /// Reads a temperature record (schema in imu_calibration.h and
-/// docs/calibration-temperature.md). Throws InputError (file, line, key).
-std::vector<TemperatureRun> ReadTemperatureRuns(const std::string& record_path,
-                                                TemperatureCalibrationOptions* options);
+/// docs/calibration-temperature.md). Throws InputError (file, line, key), also for a
+/// record that mixes chamber and warm-up runs.
+TemperatureRecord ReadTemperatureRecord(const std::string& record_path);
 
 }  // namespace navtwin::calibration

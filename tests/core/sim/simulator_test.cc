@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -193,6 +195,51 @@ TEST(Simulator, PendulumWritesTheEncoderAngle) {
   const YAML::Node errors = YAML::LoadFile(dir + "/errors.yaml");
   EXPECT_DOUBLE_EQ(errors["trajectory"]["angle_noise_deg"].as<double>(), 0.01);
   RemoveDir(dir);
+}
+
+// A warm-up (temperature_profile not constant) also writes the IMU's temperature sensor,
+// temperature.csv: one reading per IMU sample with its time tag, the profile at that time;
+// a constant profile writes none.
+TEST(Simulator, WarmUpWritesTheImuTemperature) {
+  const std::string dir = MakeTempDir();
+  const std::string base =
+      "name: warmup\nduration_s: 20\nstart: {lat_deg: 37.45, lon_deg: 126.65, h_m: 20}\n"
+      "trajectory: {kind: multiposition, dwell_s: 5, steps: [{euler_deg: [0, 0, 0]}, {euler_deg: [90, 0, 0]}]}\n";
+  const Scenario scenario = ParseScenario(ParseYaml(
+      base + "imu: {rate_hz: 100, errors: {temperature_profile: {initial_degC: 0, final_degC: 40, time_constant_s: 300}}}\n",
+      "warmup.yaml"));
+  const TemperatureProfile& profile = scenario.imu.errors.temperature;
+  const SimulationReport report = Simulate(scenario, SimulationOptions(), dir);
+  EXPECT_NE(std::find(report.files.begin(), report.files.end(), dir + "/temperature.csv"), report.files.end());
+  std::ifstream in(dir + "/temperature.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "t_s,temperature_degC");
+  auto imu = OpenKfginsImu(dir + "/imu.txt");
+  ImuSample s;
+  std::size_t rows = 0;
+  double previous = -1.0;
+  while (std::getline(in, line) && imu->Next(&s)) {
+    const double t = std::stod(line.substr(0, line.find(','))), T = std::stod(line.substr(line.find(',') + 1));
+    EXPECT_EQ(t, s.t_s);
+    // No delay or clock offset: the time tag is the truth time; written in the shortest
+    // form that reads back exactly.
+    EXPECT_EQ(T, profile.At(t));
+    EXPECT_GT(T, previous);  // warming
+    previous = T;
+    ++rows;
+  }
+  EXPECT_EQ(rows, report.imu_samples);
+  // 20 s of a 300 s time constant from 0 to 40 degC: 40 (1 - e^(-1/15)) = 2.58 degC.
+  EXPECT_NEAR(previous, 40.0 * (1.0 - std::exp(-20.0 / 300.0)), 1e-9);
+  RemoveDir(dir);
+
+  const std::string constant_dir = MakeTempDir();
+  const Scenario constant = ParseScenario(ParseYaml(
+      base + "imu: {rate_hz: 100, errors: {temperature_profile: {initial_degC: 40}}}\n", "constant.yaml"));
+  Simulate(constant, SimulationOptions(), constant_dir);
+  EXPECT_FALSE(std::ifstream(constant_dir + "/temperature.csv").good());
+  RemoveDir(constant_dir);
 }
 
 TEST(Simulator, SameSeedSameBytesOtherSeedOtherDraws) {

@@ -5,7 +5,9 @@
 // chamber) with the SAME fixed error constants in every run and independent noise, the
 // recovered polynomial coefficients against the simulator's truth, a Monte Carlo of the
 // 3-sigma fraction, orders 1 and 3, the errors for bad data, and one calibration through
-// a record file.
+// a record file. Then warm-up data (CalibrateWarmUp): one 16-position run warming from 0 to
+// 40 degC, its Monte Carlo, the span check, the temperature file's errors, and a warm-up
+// simulated into files (imu.txt, temperature.csv) and calibrated through a record.
 #include "problems/calibration/temperature.h"
 
 #include <algorithm>
@@ -31,6 +33,8 @@
 #include "core/sim/calibration_rig.h"
 #include "core/sim/inertial_errors.h"
 #include "core/sim/random.h"
+#include "core/sim/scenario.h"
+#include "core/sim/simulator.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -581,6 +585,324 @@ TEST_F(TemperatureRecord, BadRecordsNameFileLineAndKey) {
                      "runs[0].colour", 3);
   expect_input_error("latitude_deg: 30\nruns:\n  - {temperature_degC: 900, imu: a.txt}\n",
                      "runs[0].temperature_degC", 3);
+}
+
+// ---------------------------------------------------------------------------------------
+// Warm-up data: one multi-position run during which the IMU warms from 0 to 40 degC
+// (time constant 300 s, the seed's self-heating), the temperature sensor read at every
+// IMU sample (as the simulator's temperature.csv).
+
+constexpr double kWarmUpInitialDegC = 0.0;
+constexpr double kWarmUpFinalDegC = 40.0;
+constexpr double kWarmUpTimeConstantS = 300.0;
+
+/// 16 positions: the six +-1 g positions, the same in reverse order (each axis at +1 g and
+/// -1 g early and late in the warm-up) and four tilted by 45 deg (misalignment).
+const std::vector<Eigen::Vector3d> kWarmUpPositionsDeg = {
+    {0, 0, 0},   {180, 0, 0}, {90, 0, 0},  {-90, 0, 0}, {0, 90, 0},  {0, -90, 0}, {0, -90, 0}, {0, 90, 0},
+    {-90, 0, 0}, {90, 0, 0},  {180, 0, 0}, {0, 0, 0},   {45, 0, 0},  {0, 45, 0},  {-45, 0, 0}, {0, -45, 0}};
+
+/// The exact increments of a table schedule (no sensor error) at rate_hz.
+std::vector<ImuSample> ExactIncrements(const sim::MultiPositionConfig& schedule, double rate_hz) {
+  const sim::MultiPositionRig rig(schedule);
+  const wgs84::Geodetic start{kLatitudeDeg * kDeg, 114.0 * kDeg, kHeightM};
+  std::vector<ImuSample> exact;
+  sim::SynthesizeImu(rig, start, rate_hz, rig.duration_s(), [&](const ImuSample& s, const NavState&) {
+    if (s.dt_s > 0.0) exact.push_back(s);  // the first call is the initial state, no increment
+  });
+  return exact;
+}
+
+/// A warm-up run: the exact increments through the error model at the profile's
+/// temperature of each interval's middle (as core/sim/imu_simulator.cc), the temperature
+/// sensor read at every sample's time tag.
+WarmUpRun WarmUp(const sim::InertialErrorConfig& errors, const sim::MultiPositionConfig& schedule,
+                 const std::vector<ImuSample>& exact, double initial_degC, double final_degC, std::uint64_t seed) {
+  sim::InertialErrorConfig e = errors;
+  e.temperature.initial_degC = initial_degC;
+  e.temperature.final_degC = final_degC;
+  e.temperature.time_constant_s = kWarmUpTimeConstantS;
+  sim::InertialErrorModel model(e, sim::Rng(seed).Stream("imu"), false);
+  WarmUpRun run;
+  run.data.schedule = schedule;
+  run.data.latitude_rad = kLatitudeDeg * kDeg;
+  run.data.height_m = kHeightM;
+  run.data.imu_path = "warm-up " + std::to_string(seed);
+  run.temperature.path = "temperature " + std::to_string(seed);
+  for (const ImuSample& s : exact) {
+    ImuSample m = s;
+    model.Apply(s.t_s, s.dt_s, e.temperature.At(s.t_s - 0.5 * s.dt_s), s.dtheta_b_rad, s.dv_b_mps, &m.dtheta_b_rad,
+                &m.dv_b_mps);
+    run.data.imu.push_back(m);
+    run.temperature.t_s.push_back(s.t_s);
+    run.temperature.temperature_degC.push_back(e.temperature.At(s.t_s));
+  }
+  return run;
+}
+
+/// The value of an estimated name ("<param>" or "<param>.dT<k>") in a result.
+double EstimateOf(const ImuCalibrationResult& r, const std::string& name) {
+  const std::size_t dot = name.rfind(".dT");
+  const std::string base = dot == std::string::npos ? name : name.substr(0, dot);
+  const int k = dot == std::string::npos ? 0 : std::atoi(name.c_str() + dot + 3);
+  for (int i = 0; i < kGSensitivityParameters; ++i) {
+    if (base == GSensitivityParameterName(i)) return r.calibration.g_sensitivity(i);
+  }
+  const TemperatureTerms& t = *r.calibration.temperature;
+  for (const char* triad : {"gyro", "accel"}) {
+    const bool gyro = std::string(triad) == "gyro";
+    for (int i = 0; i < kTriadParameters; ++i) {
+      if (base != TriadParameterName(triad, i)) continue;
+      if (k == 0) return (gyro ? r.calibration.gyro : r.calibration.accel)(i);
+      const auto& terms = gyro ? (i < 3 ? t.gyro_scale_factor : t.gyro_bias_rad_per_s)
+                               : (i < 3 ? t.accel_scale_factor : t.accel_bias_mps2);
+      return terms[k - 1](i < 3 ? i : i - 9);
+    }
+  }
+  ADD_FAILURE() << "unknown name " << name;
+  return 0.0;
+}
+
+/// z of every estimated coefficient of a warm-up result against the truth.
+std::vector<std::pair<std::string, double>> WarmUpZScores(const ImuCalibrationResult& r,
+                                                          const std::vector<Truth>& truth) {
+  std::vector<std::pair<std::string, double>> z;
+  for (std::size_t i = 0; i < r.estimated.size(); ++i) {
+    const std::string& name = r.estimated[i];
+    const std::size_t dot = name.rfind(".dT");
+    const std::string base = dot == std::string::npos ? name : name.substr(0, dot);
+    const int k = dot == std::string::npos ? 0 : std::atoi(name.c_str() + dot + 3);
+    for (const Truth& t : truth) {
+      if (t.name == base && k < static_cast<int>(t.coefficients.size())) {
+        z.push_back({name, (EstimateOf(r, name) - t.coefficients[k]) / std::sqrt(r.covariance(i, i))});
+      }
+    }
+  }
+  return z;
+}
+
+double SigmaOf(const ImuCalibrationResult& r, const std::string& name) {
+  const auto it = std::find(r.estimated.begin(), r.estimated.end(), name);
+  EXPECT_NE(it, r.estimated.end()) << name;
+  if (it == r.estimated.end()) return std::numeric_limits<double>::quiet_NaN();
+  const int i = static_cast<int>(it - r.estimated.begin());
+  return std::sqrt(r.covariance(i, i));
+}
+
+/// TruthErrors with a quarter of its white noise (a better IMU): one warm-up run then
+/// resolves the temperature terms (at the chamber tests' noise its sigmas are 4x larger,
+/// see MonteCarloSigmaIsHonest).
+sim::InertialErrorConfig QuieterErrors() {
+  sim::InertialErrorConfig e = TruthErrors();
+  e.gyro.white_noise /= 4.0;
+  e.accel.white_noise /= 4.0;
+  return e;
+}
+
+TEST(TemperatureWarmUp, RecoversTheQuadratics) {
+  const sim::InertialErrorConfig errors = QuieterErrors();
+  const sim::MultiPositionConfig schedule = Schedule(kWarmUpPositionsDeg, 45.0);
+  const std::vector<WarmUpRun> runs = {
+      WarmUp(errors, schedule, ExactIncrements(schedule, kRateHz), kWarmUpInitialDegC, kWarmUpFinalDegC, 41)};
+  TemperatureCalibrationOptions options;
+  options.reference_degC = kSimReferenceDegC;
+  const WarmUpCalibration cal = CalibrateWarmUp(runs, options);
+  const ImuCalibrationResult& r = cal.result;
+  ASSERT_TRUE(r.calibration.temperature.has_value());
+  EXPECT_EQ(r.calibration.temperature->reference_degC, kSimReferenceDegC);
+  ASSERT_EQ(r.calibration.temperature->accel_bias_mps2.size(), 2u);
+  ASSERT_EQ(r.covariance.rows(), static_cast<int>(r.estimated.size()));
+  EXPECT_TRUE(r.covariance.allFinite());
+  EXPECT_EQ(r.positions, 16);
+  // 16 holds of 45 s less 2 x 0.5 s settling: 4 segments of 11 s each.
+  EXPECT_EQ(cal.segments.size(), 64u);
+  // Gyro scale factors and misalignments need rotations: listed, not estimated.
+  EXPECT_EQ(r.unobservable.size(), 9u);
+  for (const std::string& u : r.unobservable) EXPECT_EQ(u.rfind("gyro.", 0), 0u) << u;
+  EXPECT_FALSE(r.calibration.gyro_sigma->head<9>().allFinite());
+
+  const auto z = WarmUpZScores(r, TruthOf(errors, kSimReferenceDegC, 2));
+  // accel: 3 x (scale, 2 misalignments, bias, 2 + 2 temperature terms); gyro: 3 x (bias,
+  // 2 temperature terms) and 9 g-sensitivities.
+  EXPECT_EQ(z.size(), 42u);
+  double worst = 0.0;
+  for (const auto& [name, score] : z) {
+    // One fixed draw of 42 coefficients: 4.5 sigma leaves them all inside with
+    // probability > 0.9997 when the sigma is honest.
+    EXPECT_LT(std::abs(score), 4.5) << name;
+    worst = std::max(worst, std::abs(score));
+  }
+  std::cout << "warm-up 0 -> 40 degC, 16 positions: largest |z| " << worst << " of " << z.size() << "\n";
+  // The temperature effects are resolved: each coefficient below is > 5 sigma from 0.
+  for (const char* name : {"accel.scale_factor.x.dT1", "accel.bias.z.dT2", "accel.bias.z.dT1",
+                           "accel.bias.x.dT2", "gyro.bias.x.dT1", "gyro.bias.z.dT2"}) {
+    const double value = EstimateOf(r, name), sigma = SigmaOf(r, name);
+    std::cout << name << " = " << value << " +- " << sigma << "\n";
+    EXPECT_GT(std::abs(value) / sigma, 5.0) << name;
+  }
+}
+
+// Monte Carlo: 100 warm-ups with independent noise (the same exact increments, 20 Hz to
+// keep the test short), the fraction of coefficients within 3 sigma of the truth.
+TEST(TemperatureWarmUp, MonteCarloSigmaIsHonest) {
+  const sim::InertialErrorConfig errors = TruthErrors();
+  const sim::MultiPositionConfig schedule = Schedule(kWarmUpPositionsDeg, 45.0);
+  const std::vector<ImuSample> exact = ExactIncrements(schedule, 20.0);
+  const std::vector<Truth> truth = TruthOf(errors, kSimReferenceDegC, 2);
+  const int calibrations = 100;
+  std::map<std::string, int> within;
+  int total = 0, total_within = 0, temperature_terms = 0, temperature_within = 0;
+  for (int m = 0; m < calibrations; ++m) {
+    TemperatureCalibrationOptions options;
+    options.reference_degC = kSimReferenceDegC;
+    const WarmUpCalibration cal = CalibrateWarmUp(
+        {WarmUp(errors, schedule, exact, kWarmUpInitialDegC, kWarmUpFinalDegC, 500 + m)}, options);
+    for (const auto& [name, score] : WarmUpZScores(cal.result, truth)) {
+      const bool in = std::abs(score) <= 3.0;
+      within[name] += in;
+      ++total;
+      total_within += in;
+      if (name.find(".dT") != std::string::npos) {
+        ++temperature_terms;
+        temperature_within += in;
+      }
+    }
+  }
+  int worst = calibrations;
+  std::string worst_name;
+  for (const auto& [name, n] : within) {
+    if (n < worst) {
+      worst = n;
+      worst_name = name;
+    }
+  }
+  const double fraction = static_cast<double>(total_within) / total;
+  const double fraction_t = static_cast<double>(temperature_within) / temperature_terms;
+  std::cout << calibrations << " warm-up calibrations, " << within.size() << " coefficients each: "
+            << 100.0 * fraction << " % within 3 sigma (temperature coefficients " << 100.0 * fraction_t
+            << " %); worst " << worst_name << " " << worst << "/" << calibrations << "\n";
+  // The criterion: >= 95 % within 3 sigma (an honest sigma gives 99.7 % of 4200
+  // z-scores). Per coefficient, fewer than 95 of 100 by chance has p ~ 5e-7.
+  EXPECT_GE(fraction, 0.95);
+  EXPECT_GE(fraction_t, 0.95);
+  EXPECT_GE(worst, 95) << worst_name;
+}
+
+TEST(TemperatureWarmUp, SpanTooSmall) {
+  // 20 -> 30 degC with a 300 s time constant over a 190 s schedule: the means of the 12
+  // segments (2 per 29 s hold) span 20.25 .. 24.55 degC, short of the 20 degC an order-2 fit needs.
+  const sim::MultiPositionConfig schedule = Schedule(kSixPositionsDeg, 30.0);
+  const WarmUpRun run = WarmUp(TruthErrors(), schedule, ExactIncrements(schedule, 20.0), 20.0, 30.0, 42);
+  ExpectRuntimeError([&] { CalibrateWarmUp({run}); },
+                     "warm-up temperature calibration (mean temperatures of the 12 segments): order 2 needs a "
+                     "temperature span of at least 20 degC (10 degC per order), got 4.298 degC (20.25 .. 24.55 degC)");
+  // 20 -> 25 degC over 70 s: every segment within 1 degC, a single temperature.
+  const sim::MultiPositionConfig short_schedule = Schedule(kSixPositionsDeg, 10.0);
+  const WarmUpRun flat = WarmUp(TruthErrors(), short_schedule, ExactIncrements(short_schedule, 20.0), 20.0, 25.0, 43);
+  ExpectRuntimeError([&] { CalibrateWarmUp({flat}); },
+                     "(mean temperatures of the 6 segments): order 2 needs at least 3 temperatures, got 1");
+}
+
+TEST(TemperatureWarmUp, TooFewPositions) {
+  const std::vector<Eigen::Vector3d> five(kSixPositionsDeg.begin(), kSixPositionsDeg.begin() + 5);
+  const sim::MultiPositionConfig schedule = Schedule(five, 10.0);
+  const WarmUpRun run = WarmUp(TruthErrors(), schedule, ExactIncrements(schedule, 20.0), 0.0, 40.0, 43);
+  ExpectRuntimeError([&] { CalibrateWarmUp({run}); }, "the schedule has 5 static positions; at least 6 are needed");
+}
+
+TEST_F(TemperatureRecord, TemperatureFileErrorsNameFileLineAndField) {
+  const auto expect_input_error = [&](const std::string& text, const std::string& field, long line) {
+    const std::string path = Write("temperature.csv", text);
+    try {
+      ReadTemperatureFile(path);
+      ADD_FAILURE() << "no InputError for:\n" << text;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), path);
+      EXPECT_EQ(e.field(), field) << e.what();
+      EXPECT_EQ(e.line(), line) << e.what();
+    }
+  };
+  expect_input_error("t_s,temperature_degC\n0.0,20.0\n0.1,nan\n", "temperature_degC", 3);
+  expect_input_error("t_s,temperature_degC\n0.0,20.0\n0.1,20.1\n0.05,20.2\n", "t_s", 4);
+  expect_input_error("t_s,temp_C\n0.0,20.0\n", "temperature_degC", 1);
+  expect_input_error("t_s,temperature_degC\n0.0,20.0\n0.1\n", "", 3);
+  const TemperatureSeries ok = ReadTemperatureFile(Write("ok.csv", "t_ms,temperature_degC\n0,20\n100,20.5\n"));
+  ASSERT_EQ(ok.t_s.size(), 2u);
+  EXPECT_EQ(ok.t_s[1], 0.1);
+  EXPECT_EQ(ok.temperature_degC[1], 20.5);
+}
+
+/// A record's table schedule in the simulator's YAML schema.
+std::string ScheduleYaml(const std::vector<Eigen::Vector3d>& euler_deg, double dwell_s) {
+  std::string y = "{kind: multiposition, rotation_s: 2, dwell_s: " + std::to_string(dwell_s) + ", steps: [";
+  for (std::size_t i = 0; i < euler_deg.size(); ++i) {
+    const Eigen::Vector3d& e = euler_deg[i];
+    y += std::string(i ? ", " : "") + "{euler_deg: [" + std::to_string(e.x()) + ", " + std::to_string(e.y()) + ", " +
+         std::to_string(e.z()) + "]}";
+  }
+  return y + "]}";
+}
+
+// The whole path through files: `navtwin simulate` of a warm-up on the table writes
+// imu.txt and temperature.csv; a record names them; CalibrateTemperatureRecord recovers the
+// simulator's truth. A record mixing chamber and warm-up runs is refused.
+TEST_F(TemperatureRecord, WarmUpThroughTheSimulatorFiles) {
+  const std::string trajectory = ScheduleYaml(kWarmUpPositionsDeg, 45.0);
+  const double duration_s = sim::MultiPositionRig(Schedule(kWarmUpPositionsDeg, 45.0)).duration_s();
+  const std::string scenario_yaml =
+      "name: warmup\nduration_s: " + std::to_string(duration_s) + "\nstart: {lat_deg: " + std::to_string(kLatitudeDeg) +
+      ", lon_deg: 114, h_m: " + std::to_string(kHeightM) + "}\ntrajectory: " + trajectory +
+      "\nimu:\n  rate_hz: 20\n  errors:\n"
+      "    gyro: {bias_fixed_deg_h: [20, -12, 16], arw_deg_sqrt_h: 0.1,\n"
+      "           temperature: {bias_fixed_deg_h_per_degC: [0.4, -0.3, 0.2], bias_fixed_deg_h_per_degC2: [0.008, 0.006, -0.01]}}\n"
+      "    accel: {bias_fixed_ug: [3000, -5000, 4000], scale_factor_fixed_ppm: [1000, -800, 600], vrw_m_s_sqrt_h: 0.06,\n"
+      "            temperature: {bias_fixed_ug_per_degC: [20, -10, 15], bias_fixed_ug_per_degC2: [0.3, -0.2, 0.4],\n"
+      "                          scale_factor_fixed_ppm_per_degC: [20, -15, 25], scale_factor_fixed_ppm_per_degC2: [0.3, 0.2, -0.4]}}\n"
+      "    temperature_profile: {reference_degC: 25, initial_degC: 0, final_degC: 40, time_constant_s: 300}\n";
+  const sim::Scenario scenario = sim::ParseScenario(sim::ParseYaml(scenario_yaml, "warmup.yaml"));
+  sim::SimulationOptions sim_options;
+  sim_options.seed = 44;
+  const sim::TemporarySimulation simulation(scenario, sim_options, "navtwin_warmup_");
+  const std::string record = "order: 2\nlatitude_deg: " + std::to_string(kLatitudeDeg) +
+                             "\nheight_m: " + std::to_string(kHeightM) +
+                             "\nreference_degC: 25\nsegment_s: 10\nruns:\n  - {temperature: " +
+                             simulation.path("temperature.csv") + ", imu: " + simulation.path("imu.txt") +
+                             ", trajectory: " + trajectory + "}\n";
+  const ImuCalibrationResult r = CalibrateTemperatureRecord(Write("warmup.yaml", record));
+  EXPECT_EQ(r.positions, 16);
+  ASSERT_TRUE(r.calibration.temperature.has_value());
+  const sim::InertialErrorConfig& e = scenario.imu.errors;
+  // Zero-valued truths where the YAML gives none (misalignment, G, gyro scale factor).
+  sim::InertialErrorConfig truth = e;
+  for (sim::TriadErrorConfig* t : {&truth.gyro, &truth.accel}) {
+    for (sim::AxisConstant* a : {&t->bias, &t->scale_factor, &t->bias_per_degC, &t->bias_per_degC2,
+                                 &t->scale_factor_per_degC, &t->scale_factor_per_degC2}) {
+      if (!a->fixed) a->fixed = Eigen::Vector3d::Zero();
+    }
+    if (!t->misalignment.fixed) t->misalignment.fixed = Eigen::Matrix3d::Zero();
+  }
+  if (!truth.g_sensitivity.fixed) truth.g_sensitivity.fixed = Eigen::Matrix3d::Zero();
+  const auto z = WarmUpZScores(r, TruthOf(truth, kSimReferenceDegC, 2));
+  EXPECT_EQ(z.size(), 42u);
+  for (const auto& [name, score] : z) EXPECT_LT(std::abs(score), 4.5) << name;  // one draw of 42: as above
+  const double value = EstimateOf(r, "accel.bias.x.dT1");
+  EXPECT_GT(std::abs(value) / SigmaOf(r, "accel.bias.x.dT1"), 5.0);  // resolved, not just consistent
+
+  // Chamber and warm-up runs in one record: refused, naming the second kind's run.
+  const std::string mixed = "latitude_deg: 30\nruns:\n  - {temperature_degC: 20, imu: " + simulation.path("imu.txt") +
+                            ", trajectory: " + trajectory + "}\n  - {temperature: " +
+                            simulation.path("temperature.csv") + ", imu: " + simulation.path("imu.txt") +
+                            ", trajectory: " + trajectory + "}\n";
+  const std::string mixed_path = Write("mixed.yaml", mixed);
+  try {
+    CalibrateTemperatureRecord(mixed_path);
+    ADD_FAILURE() << "a mixed record was accepted";
+  } catch (const InputError& err) {
+    EXPECT_EQ(err.file(), mixed_path);
+    EXPECT_EQ(err.field(), "runs[1].temperature") << err.what();
+    EXPECT_EQ(err.line(), 4) << err.what();
+    EXPECT_NE(std::string(err.what()).find("mixes chamber runs"), std::string::npos) << err.what();
+  }
 }
 
 }  // namespace
