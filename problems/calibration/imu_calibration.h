@@ -7,12 +7,15 @@
 // docs/calibration-imu.md):
 //   multiposition: {imu: FILE, latitude_deg, height_m, trajectory: {kind: multiposition,...}}
 //                  the table schedule in the simulator's schema (core/sim/calibration_rig.h),
-//                  its times on the IMU's time scale.
+//                  its times on the IMU's time scale; optional settle_s,
+//                  accel_saturation_mps2, gyro_saturation_deg_s, g_sensitivity.
 //   pendulum:      {latitude_deg, height_m, runs: [{imu: FILE, angle: FILE, length_m,
 //                  mounting | mounting_deg}, ...]}; angle files t_s,theta_rad|theta_deg.
 //   temperature:   {order (default 2), latitude_deg, height_m, reference_degC (optional),
 //                  runs: [{temperature_degC, imu: FILE, trajectory: {kind: multiposition,
-//                  ...}}, ...]}  (docs/calibration-temperature.md)
+//                  ...}}, ...]} for chamber soaks; a warm-up run gives `temperature: FILE`
+//                  (t_s,temperature_degC) instead of temperature_degC, with segment_s
+//                  (docs/calibration-temperature.md).
 #pragma once
 
 #include <string>

@@ -137,9 +137,11 @@ Residuals BuildResiduals(const MultiPositionData& data, const MultiPositionOptio
   const Eigen::Vector3d g_n(0.0, 0.0, g);
   const Eigen::Vector3d omega_ie_n = wgs84::EarthRateNed(data.latitude_rad);
   const auto saturated = [&options](const ImuSample& s) {
-    return (options.accel_saturation_mps2 > 0.0 && s.dv_b_mps.norm() > options.accel_saturation_mps2 * s.dt_s) ||
+    // A sensor's range is per axis: any axis at or beyond it.
+    return (options.accel_saturation_mps2 > 0.0 &&
+            s.dv_b_mps.cwiseAbs().maxCoeff() >= options.accel_saturation_mps2 * s.dt_s) ||
            (options.gyro_saturation_rad_per_s > 0.0 &&
-            s.dtheta_b_rad.norm() > options.gyro_saturation_rad_per_s * s.dt_s);
+            s.dtheta_b_rad.cwiseAbs().maxCoeff() >= options.gyro_saturation_rad_per_s * s.dt_s);
   };
 
   // Holds: the samples whose interval (t - dt, t] lies inside the trimmed window.
@@ -678,7 +680,8 @@ ImuCalibrationResult RecursiveMultiPosition::Current() const {
 // ------------------------------------------------------------------------ records
 
 MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::string& base_dir) {
-  node.RequireKeys({"imu", "latitude_deg", "height_m", "trajectory"});
+  node.RequireKeys({"imu", "latitude_deg", "height_m", "trajectory", "settle_s", "accel_saturation_mps2",
+                    "gyro_saturation_deg_s", "g_sensitivity"});
   if (!node.Has("imu")) node.Fail("imu", "missing: the IMU file of the multi-position record");
   if (!node.Has("trajectory")) {
     node.Fail("trajectory", "missing: the table schedule {kind: multiposition, steps: [...]}");
@@ -707,7 +710,16 @@ MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::
 ImuCalibrationResult CalibrateMultiPositionRecord(const std::string& record_path) {
   const sim::ConfigNode root = sim::LoadYamlFile(record_path);
   const std::string base_dir = std::filesystem::path(record_path).parent_path().string();
-  return CalibrateMultiPosition(ReadMultiPositionData(root, base_dir));
+  return CalibrateMultiPosition(ReadMultiPositionData(root, base_dir), ReadMultiPositionOptions(root));
+}
+
+MultiPositionOptions ReadMultiPositionOptions(const sim::ConfigNode& node) {
+  MultiPositionOptions options;
+  options.settle_s = node.NonNegative("settle_s", options.settle_s);
+  options.accel_saturation_mps2 = node.NonNegative("accel_saturation_mps2", 0.0);
+  options.gyro_saturation_rad_per_s = node.NonNegative("gyro_saturation_deg_s", 0.0) * kDegToRad;
+  options.estimate_g_sensitivity = node.Bool("g_sensitivity", options.estimate_g_sensitivity);
+  return options;
 }
 
 }  // namespace navtwin::calibration

@@ -38,7 +38,8 @@ struct MultiPositionData {
 struct MultiPositionOptions {
   double settle_s = 0.5;           ///< left out at both ends of every hold
   bool estimate_g_sensitivity = true;
-  /// Specific force magnitude (m/s^2) above which a sample counts as saturated (<= 0: none).
+  /// Sensor range per axis: a sample with any axis at or beyond it counts as saturated and
+  /// is left out with a note (<= 0: no limit).
   double accel_saturation_mps2 = 0.0;
   double gyro_saturation_rad_per_s = 0.0;
 };
@@ -59,6 +60,10 @@ ImuCalibrationResult CalibrateMultiPosition(const MultiPositionData& data, const
 /// Reads {imu, latitude_deg, height_m, trajectory} from a record node (relative paths
 /// against base_dir). Throws InputError (file, line, key).
 MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::string& base_dir);
+
+/// The record's optional keys: settle_s, accel_saturation_mps2, gyro_saturation_deg_s (0: no
+/// limit), g_sensitivity (bool). Throws InputError (file, line, key) for negative values.
+MultiPositionOptions ReadMultiPositionOptions(const sim::ConfigNode& node);
 
 /// The recursive form: feed positions in schedule order.
 class RecursiveMultiPosition {

@@ -36,6 +36,13 @@ TEST(CalibrationCompensationTest, CalibratedImuNavigatesBetter) {
                                 "/calibration.yaml --format=json");
   ASSERT_EQ(cal.exit_code, 0) << cal.err;
   ASSERT_TRUE(Exists(dir + "/calibration.yaml"));
+  // A range below 1 g saturates the vertical axis in every hold: exit 1, the reason named.
+  std::ofstream(dir + "/record.yaml", std::ios::app) << "accel_saturation_mps2: 9.0\n";
+  const RunResult saturated = Navtwin("calibrate-imu --rig multiposition --data " + dir + "/record.yaml --out " + dir +
+                                      "/saturated.yaml");
+  EXPECT_EQ(saturated.exit_code, 1);
+  EXPECT_NE(saturated.err.find("saturated"), std::string::npos) << saturated.err;
+  EXPECT_FALSE(Exists(dir + "/saturated.yaml"));
 
   ASSERT_EQ(Navtwin("simulate --scenario " + kDocs + "nav-mems-fixed-errors.yaml --seed 1 --out " + dir + "/nav").exit_code, 0);
   // The configurations name init.nav relative to themselves: they go beside it.
