@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ceres/ceres.h>
@@ -20,6 +21,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "core/earth.h"
+#include "core/io/csv_series.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/io/text_reader.h"
@@ -473,38 +475,11 @@ std::vector<AxisProblem> AxisProblems(bool with_g) {
 }  // namespace detail
 
 AngleRecord ReadAngleFile(const std::string& path) {
+  ScalarSeries series = ReadScalarSeriesCsv(path, "theta", {{"_rad", 1.0}, {"_deg", kDegToRad}});
   AngleRecord out;
+  out.t_s = std::move(series.t_s);
+  out.theta_rad = std::move(series.value);
   out.path = path;
-  LineReader lines(path);
-  std::string line;
-  std::vector<std::string_view> fields;
-  HeaderColumns header;
-  UnitColumn time, theta;
-  bool have_header = false;
-  IncreasingTime monotonic;
-  while (lines.Next(&line)) {
-    if (IsBlank(line)) continue;
-    if (!have_header) {
-      if (Trim(line).front() == '#') continue;
-      SplitCsv(line, &fields);
-      header = HeaderColumns(fields, path, lines.line_number());
-      time = header.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
-      theta = header.RequireWithUnit("theta", {{"_rad", 1.0}, {"_deg", kDegToRad}});
-      have_header = true;
-      continue;
-    }
-    SplitCsv(line, &fields);
-    RequireFieldCount(fields.size(), header.size(), path, lines.line_number());
-    const double t = ParseDouble(fields[static_cast<std::size_t>(time.index)], path, lines.line_number(), time.name) *
-                     time.scale;
-    monotonic.Check(t, path, lines.line_number(), time.name);
-    out.t_s.push_back(t);
-    out.theta_rad.push_back(
-        ParseDouble(fields[static_cast<std::size_t>(theta.index)], path, lines.line_number(), theta.name) *
-        theta.scale);
-  }
-  if (!have_header) throw InputError(path, 0, "", "no samples (the file is empty)");
-  if (out.t_s.empty()) throw InputError(path, 0, "", "no samples (only a header)");
   return out;
 }
 

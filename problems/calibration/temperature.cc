@@ -9,12 +9,14 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
+#include "core/io/csv_series.h"
 #include "core/io/input_error.h"
 #include "core/io/text_reader.h"
 #include "core/sim/calibration_rig.h"
@@ -721,44 +723,12 @@ WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const Temp
 }
 
 TemperatureSeries ReadTemperatureFile(const std::string& path) {
+  ScalarSeries series = ReadScalarSeriesCsv(path, "temperature", {{"_degC", 1.0}}, kMinRecordTemperatureDegC,
+                                            kMaxRecordTemperatureDegC);
   TemperatureSeries out;
+  out.t_s = std::move(series.t_s);
+  out.temperature_degC = std::move(series.value);
   out.path = path;
-  LineReader lines(path);
-  std::string line;
-  std::vector<std::string_view> fields;
-  HeaderColumns header;
-  UnitColumn time;
-  int temperature = -1;
-  bool have_header = false;
-  IncreasingTime monotonic;
-  while (lines.Next(&line)) {
-    if (IsBlank(line)) continue;
-    if (!have_header) {
-      if (Trim(line).front() == '#') continue;
-      SplitCsv(line, &fields);
-      header = HeaderColumns(fields, path, lines.line_number());
-      time = header.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
-      temperature = header.Require("temperature_degC");
-      have_header = true;
-      continue;
-    }
-    SplitCsv(line, &fields);
-    RequireFieldCount(fields.size(), header.size(), path, lines.line_number());
-    const double t = ParseDouble(fields[static_cast<std::size_t>(time.index)], path, lines.line_number(), time.name) *
-                     time.scale;
-    monotonic.Check(t, path, lines.line_number(), time.name);
-    const double T = ParseDouble(fields[static_cast<std::size_t>(temperature)], path, lines.line_number(),
-                                 "temperature_degC");
-    if (T < kMinRecordTemperatureDegC || T > kMaxRecordTemperatureDegC) {
-      throw InputError(path, lines.line_number(), "temperature_degC",
-                       "must be within [" + Num(kMinRecordTemperatureDegC) + ", " + Num(kMaxRecordTemperatureDegC) +
-                           "] degC, got " + Num(T));
-    }
-    out.t_s.push_back(t);
-    out.temperature_degC.push_back(T);
-  }
-  if (!have_header) throw InputError(path, 0, "", "no samples (the file is empty)");
-  if (out.t_s.empty()) throw InputError(path, 0, "", "no samples (only a header)");
   return out;
 }
 

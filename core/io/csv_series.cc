@@ -1,0 +1,54 @@
+#include "core/io/csv_series.h"
+
+#include <sstream>
+#include <string_view>
+
+#include "core/io/input_error.h"
+
+namespace navtwin {
+
+ScalarSeries ReadScalarSeriesCsv(const std::string& path, const std::string& stem,
+                                 std::initializer_list<UnitSuffix> units, double lo, double hi) {
+  ScalarSeries out;
+  out.path = path;
+  LineReader lines(path);
+  std::string line;
+  std::vector<std::string_view> fields;
+  HeaderColumns header;
+  UnitColumn time, column;
+  bool have_header = false;
+  IncreasingTime monotonic;
+  while (lines.Next(&line)) {
+    if (IsBlank(line)) continue;
+    if (!have_header) {
+      if (Trim(line).front() == '#') continue;
+      SplitCsv(line, &fields);
+      header = HeaderColumns(fields, path, lines.line_number());
+      time = header.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
+      column = header.RequireWithUnit(stem, units);
+      have_header = true;
+      continue;
+    }
+    SplitCsv(line, &fields);
+    RequireFieldCount(fields.size(), header.size(), path, lines.line_number());
+    const double t = ParseDouble(fields[static_cast<std::size_t>(time.index)], path, lines.line_number(), time.name) *
+                     time.scale;
+    monotonic.Check(t, path, lines.line_number(), time.name);
+    const double v = ParseDouble(fields[static_cast<std::size_t>(column.index)], path, lines.line_number(),
+                                 column.name) *
+                     column.scale;
+    if (v < lo || v > hi) {
+      std::ostringstream why;
+      why.precision(10);
+      why << "must be within [" << lo / column.scale << ", " << hi / column.scale << "], got " << v / column.scale;
+      throw InputError(path, lines.line_number(), column.name, why.str());
+    }
+    out.t_s.push_back(t);
+    out.value.push_back(v);
+  }
+  if (!have_header) throw InputError(path, 0, "", "no samples (the file is empty)");
+  if (out.t_s.empty()) throw InputError(path, 0, "", "no samples (only a header)");
+  return out;
+}
+
+}  // namespace navtwin
