@@ -436,45 +436,58 @@ TEST(TemperatureCalibration, OrderThree) {
 
 // Monte Carlo: the seed's chamber (3 set points, order 2) with independent noise in every
 // calibration; the fraction of coefficients within 3 sigma of the truth.
+/// Tally of z-scores over Monte Carlo calibrations: pooled, temperature terms, per name.
+struct SigmaTally {
+  std::map<std::string, int> within;
+  int total = 0, total_within = 0, temperature_terms = 0, temperature_within = 0;
+
+  void Add(const std::string& name, double score) {
+    const bool in = std::abs(score) <= 3.0;
+    within[name] += in;
+    ++total;
+    total_within += in;
+    if (name.find(".dT") != std::string::npos) {
+      ++temperature_terms;
+      temperature_within += in;
+    }
+  }
+  double fraction() const { return static_cast<double>(total_within) / total; }
+  double temperature_fraction() const { return static_cast<double>(temperature_within) / temperature_terms; }
+  /// The coefficient within 3 sigma least often, and how often.
+  std::pair<std::string, int> Worst() const {
+    std::pair<std::string, int> worst{"", std::numeric_limits<int>::max()};
+    for (const auto& [name, n] : within) {
+      if (n < worst.second) worst = {name, n};
+    }
+    return worst;
+  }
+  /// The criterion: >= 95 % within 3 sigma, pooled, for the temperature terms, and
+  /// per coefficient (fewer than 95 of 100 by chance has p ~ 1e-6 for an honest sigma).
+  void Check(int calibrations, const std::string& what) const {
+    const auto [worst_name, worst] = Worst();
+    std::cout << calibrations << " " << what << ", " << within.size() << " coefficients each: " << 100.0 * fraction()
+              << " % within 3 sigma (temperature coefficients " << 100.0 * temperature_fraction() << " %); worst "
+              << worst_name << " " << worst << "/" << calibrations << "\n";
+    EXPECT_GE(fraction(), 0.95);
+    EXPECT_GE(temperature_fraction(), 0.95);
+    EXPECT_GE(worst, 95 * calibrations / 100) << worst_name;
+  }
+};
+
 TEST(TemperatureCalibration, MonteCarloSigmaIsHonest) {
   const sim::InertialErrorConfig errors = TruthErrors();
   const int calibrations = 100;
-  std::map<std::string, int> within;
-  int total = 0, total_within = 0, temperature_terms = 0, temperature_within = 0;
+  SigmaTally tally;
   for (int m = 0; m < calibrations; ++m) {
     const std::vector<TemperatureRun> runs = SimulateChamber(errors, {-20.0, 15.0, 50.0}, 3.0, 100 + m);
     TemperatureCalibrationOptions options;
     options.reference_degC = kSimReferenceDegC;
     const TemperatureCalibration cal = CalibrateTemperature(runs, options);
     for (const auto& [name, score] : ZScores(cal, TruthOf(errors, kSimReferenceDegC, 2))) {
-      const bool in = std::abs(score) <= 3.0;
-      within[name] += in;
-      ++total;
-      total_within += in;
-      if (name.find(".dT") != std::string::npos) {
-        ++temperature_terms;
-        temperature_within += in;
-      }
+      tally.Add(name, score);
     }
   }
-  int worst = calibrations;
-  std::string worst_name;
-  for (const auto& [name, n] : within) {
-    if (n < worst) {
-      worst = n;
-      worst_name = name;
-    }
-  }
-  const double fraction = static_cast<double>(total_within) / total;
-  const double fraction_t = static_cast<double>(temperature_within) / temperature_terms;
-  std::cout << calibrations << " calibrations, " << within.size() << " coefficients each: " << 100.0 * fraction
-            << " % within 3 sigma (temperature coefficients " << 100.0 * fraction_t << " %); worst "
-            << worst_name << " " << worst << "/" << calibrations << "\n";
-  // The criterion: >= 95 % within 3 sigma. Pooled over ~4000 z-scores an honest
-  // sigma gives 99.7 %; per coefficient, fewer than 95 of 100 fails by chance with p ~ 1e-6.
-  EXPECT_GE(fraction, 0.95);
-  EXPECT_GE(fraction_t, 0.95);
-  EXPECT_GE(worst, 95) << worst_name;
+  tally.Check(calibrations, "calibrations");
 }
 
 TEST(TemperatureCalibration, TooFewTemperatures) {
@@ -750,42 +763,17 @@ TEST(TemperatureWarmUp, MonteCarloSigmaIsHonest) {
   const std::vector<ImuSample> exact = ExactIncrements(schedule, 20.0);
   const std::vector<Truth> truth = TruthOf(errors, kSimReferenceDegC, 2);
   const int calibrations = 100;
-  std::map<std::string, int> within;
-  int total = 0, total_within = 0, temperature_terms = 0, temperature_within = 0;
+  SigmaTally tally;
   for (int m = 0; m < calibrations; ++m) {
     TemperatureCalibrationOptions options;
     options.reference_degC = kSimReferenceDegC;
     const WarmUpCalibration cal = CalibrateWarmUp(
         {WarmUp(errors, schedule, exact, kWarmUpInitialDegC, kWarmUpFinalDegC, 500 + m)}, options);
     for (const auto& [name, score] : WarmUpZScores(cal.result, truth)) {
-      const bool in = std::abs(score) <= 3.0;
-      within[name] += in;
-      ++total;
-      total_within += in;
-      if (name.find(".dT") != std::string::npos) {
-        ++temperature_terms;
-        temperature_within += in;
-      }
+      tally.Add(name, score);
     }
   }
-  int worst = calibrations;
-  std::string worst_name;
-  for (const auto& [name, n] : within) {
-    if (n < worst) {
-      worst = n;
-      worst_name = name;
-    }
-  }
-  const double fraction = static_cast<double>(total_within) / total;
-  const double fraction_t = static_cast<double>(temperature_within) / temperature_terms;
-  std::cout << calibrations << " warm-up calibrations, " << within.size() << " coefficients each: "
-            << 100.0 * fraction << " % within 3 sigma (temperature coefficients " << 100.0 * fraction_t
-            << " %); worst " << worst_name << " " << worst << "/" << calibrations << "\n";
-  // The criterion: >= 95 % within 3 sigma (an honest sigma gives 99.7 % of 4200
-  // z-scores). Per coefficient, fewer than 95 of 100 by chance has p ~ 5e-7.
-  EXPECT_GE(fraction, 0.95);
-  EXPECT_GE(fraction_t, 0.95);
-  EXPECT_GE(worst, 95) << worst_name;
+  tally.Check(calibrations, "warm-up calibrations");
 }
 
 TEST(TemperatureWarmUp, SpanTooSmall) {
