@@ -1,5 +1,6 @@
 // navtwin calibrate-mag: hard and soft iron of a magnetometer record by the 3-axis ellipsoid
-// fit or the seed's 2-axis bidirectional method (problems/calibration/mag_calibration.h);
+// fit, the planar fit (3-axis data near one plane) or the seed's 2-axis bidirectional method
+// (problems/calibration/mag_calibration.h);
 // prints the calibration, the field-magnitude spread and, with --truth, the heading error
 // before and after; --out writes the calibration file (core/calibration_file.h).
 //
@@ -118,8 +119,11 @@ struct HeadingErrors {
 };
 
 /// RMS over the samples with truth of the wrapped heading minus the truth yaw, from the raw
-/// and from the calibrated field: tilt-compensated (3-axis) for the ellipsoid fit, level
-/// (x, y only) for the 2-axis bidirectional method.
+/// and from the calibrated field: tilt-compensated (3-axis) for the ellipsoid and planar fits,
+/// level (x, y only) for the 2-axis bidirectional method. The planar fit leaves the component
+/// along the plane normal raw (vertical field plus that axis' hard iron): its calibrated
+/// heading is taken from the in-plane part only, else a normal a few degrees off z (soft
+/// iron tilts the plane) would leak tens of uT into x and y.
 HeadingErrors HeadingError(const std::vector<MagSample>& mag, const std::vector<std::optional<Eigen::Vector3d>>& truth,
                            const MagCalibration& c, bool two_axis, double declination_rad) {
   HeadingErrors e;
@@ -131,7 +135,9 @@ HeadingErrors HeadingError(const std::vector<MagSample>& mag, const std::vector<
   for (std::size_t i = 0; i < mag.size(); ++i) {
     if (!truth[i] || std::abs((*truth[i])[1]) > kMaxHeadingPitch_rad) continue;
     const double before = WrapPi(heading(mag[i].m_b_uT, *truth[i]) - (*truth[i])[2]);
-    const double after = WrapPi(heading(calibration::ApplyMagCalibration(c, mag[i].m_b_uT), *truth[i]) - (*truth[i])[2]);
+    Eigen::Vector3d m_c = calibration::ApplyMagCalibration(c, mag[i].m_b_uT);
+    if (c.method == "planar") m_c -= c.uncalibrated_axis * c.uncalibrated_axis.dot(m_c);
+    const double after = WrapPi(heading(m_c, *truth[i]) - (*truth[i])[2]);
     sum_before += before * before;
     sum_after += after * after;
     ++e.samples;
@@ -165,21 +171,46 @@ std::string Fixed(double x, int digits) {
   return buf;
 }
 
+bool HasUncalibratedAxis(const MagCalibration& c) { return c.uncalibrated_axis.squaredNorm() > 0.0; }
+
+/// Population standard deviation of |m| over the record.
+double MagnitudeSpread(const std::vector<MagSample>& mag) {
+  double sum = 0.0, sum2 = 0.0;
+  for (const MagSample& s : mag) {
+    sum += s.m_b_uT.norm();
+    sum2 += s.m_b_uT.squaredNorm();
+  }
+  const double n = static_cast<double>(mag.size()), mean = sum / n;
+  return std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+}
+
 void PrintText(const MagCalibration& c, const HeadingErrors& h, const std::string& attitude) {
   std::printf("magnetometer calibration (%s): %d samples, %d down-weighted, roll/pitch from %s\n", c.method.c_str(),
               c.samples, c.downweighted, attitude.c_str());
   std::printf("  hard iron [uT]        %10.4f %10.4f %10.4f\n", c.hard_iron_uT.x(), c.hard_iron_uT.y(),
               c.hard_iron_uT.z());
-  std::printf("  hard iron sigma [uT]  %10.4f %10.4f %10.4f\n", c.hard_iron_sigma_uT.x(), c.hard_iron_sigma_uT.y(),
-              c.hard_iron_sigma_uT.z());
+  std::printf("  hard iron sigma [uT]  %10s %10s %10s\n", Fixed(c.hard_iron_sigma_uT.x(), 4).c_str(),
+              Fixed(c.hard_iron_sigma_uT.y(), 4).c_str(), Fixed(c.hard_iron_sigma_uT.z(), 4).c_str());
   for (int r = 0; r < 3; ++r) {
     std::printf("  %-21s %10.6f %10.6f %10.6f\n", r == 0 ? "soft iron A" : "", c.correction(r, 0), c.correction(r, 1),
                 c.correction(r, 2));
   }
-  std::printf("  field [uT]            %10.4f\n", c.field_uT);
+  const auto& s = c.correction_sigma;  // A00 A01 A02 A11 A12 A22
+  std::printf("  soft iron sigma       A00 %s A01 %s A02 %s A11 %s A12 %s A22 %s\n", Fixed(s[0], 6).c_str(),
+              Fixed(s[1], 6).c_str(), Fixed(s[2], 6).c_str(), Fixed(s[3], 6).c_str(), Fixed(s[4], 6).c_str(),
+              Fixed(s[5], 6).c_str());
+  const bool in_plane = HasUncalibratedAxis(c);
+  if (in_plane) {
+    const Eigen::Vector3d& n = c.uncalibrated_axis;
+    std::printf("  NOT calibrated along  %10.4f %10.4f %10.4f  (sensor axes: hard iron 0 and A identity along it)\n",
+                n.x(), n.y(), n.z());
+    std::printf("  in-plane coverage     %10.1f deg\n", c.coverage_deg);
+  }
+  if (c.method == "planar") std::printf("  off-plane RMS [uT]    %10.4f\n", c.out_of_plane_rms_uT);
+  std::printf("  field [uT]            %10.4f%s\n", c.field_uT, in_plane ? "  (in the plane)" : "");
   std::printf("  residual RMS [uT]     %10.4f\n", c.residual_rms_uT);
-  std::printf("  |m| spread [uT]       before %s  after %s\n", Fixed(c.field_spread_before_uT, 4).c_str(),
-              Fixed(c.field_spread_after_uT, 4).c_str());
+  std::printf("  %-21s before %s  after %s\n", in_plane ? "in-plane |m| spread" : "|m| spread [uT]",
+              Fixed(c.field_spread_before_uT, 4).c_str(), Fixed(c.field_spread_after_uT, 4).c_str());
   std::printf("  heading error RMS [deg] before %s  after %s  (%d samples with truth)\n",
               Fixed(h.before_deg, 3).c_str(), Fixed(h.after_deg, 3).c_str(), h.samples);
 }
@@ -196,7 +227,19 @@ void PrintJson(const MagCalibration& c, const HeadingErrors& h, const std::strin
     for (int k = 0; k < 3; ++k) w.Value(c.correction(r, k));
     w.EndArray();
   }
-  w.EndArray()
+  w.EndArray().Key("soft_iron_sigma").BeginArray();  // A00 A01 A02 A11 A12 A22; NaN -> null
+  for (int i = 0; i < 6; ++i) w.Value(c.correction_sigma[i]);
+  w.EndArray().Key("uncalibrated_axis_sensor");
+  if (HasUncalibratedAxis(c)) {
+    w.BeginArray();
+    for (int i = 0; i < 3; ++i) w.Value(c.uncalibrated_axis[i]);
+    w.EndArray();
+  } else {
+    w.Value(NAN);  // null: every axis calibrated
+  }
+  w.Field("spread_of", HasUncalibratedAxis(c) ? "in-plane |m|" : "|m|")
+      .Field("coverage_deg", HasUncalibratedAxis(c) ? c.coverage_deg : NAN)
+      .Field("out_of_plane_rms_uT", c.method == "planar" ? c.out_of_plane_rms_uT : NAN)
       .Field("field_uT", c.field_uT)
       .Field("residual_rms_uT", c.residual_rms_uT)
       .Field("heading_error_before_deg", h.before_deg)  // NaN -> null (no truth)
@@ -215,13 +258,13 @@ void PrintJson(const MagCalibration& c, const HeadingErrors& h, const std::strin
 int RunCalibrateMag(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args.front() + "'");
   if (FLAGS_mag.empty()) return Usage("--mag FILE is required");
-  if (FLAGS_method != "ellipsoid" && FLAGS_method != "bidirectional") {
-    return Usage("--method must be ellipsoid or bidirectional, got '" + FLAGS_method + "'");
+  if (FLAGS_method != "ellipsoid" && FLAGS_method != "planar" && FLAGS_method != "bidirectional") {
+    return Usage("--method must be ellipsoid, planar or bidirectional, got '" + FLAGS_method + "'");
   }
   if (!std::isfinite(FLAGS_declination_deg)) return Usage("--declination_deg must be a finite angle, deg");
   if (!(std::isfinite(FLAGS_field_uT) && FLAGS_field_uT >= 0.0)) return Usage("--field_uT must be >= 0 (0: from the data)");
   const bool two_axis = FLAGS_method == "bidirectional";
-  if (two_axis && FLAGS_field_uT != 0.0) return Usage("--field_uT goes with --method ellipsoid");
+  if (FLAGS_method != "ellipsoid" && FLAGS_field_uT != 0.0) return Usage("--field_uT goes with --method ellipsoid");
 
   std::vector<MagSample> mag = ReadAll<MagSample>(*OpenMag(FLAGS_mag));
   if (mag.empty()) throw InputError(FLAGS_mag, 0, "t_s", "no magnetometer samples");
@@ -248,25 +291,33 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
   }
 
   MagCalibration c;
-  if (two_axis) {
-    // Only the samples with an attitude enter the tilt-gated fit.
-    std::vector<MagSample> used;
-    std::vector<Eigen::Vector2d> used_rp;
-    for (std::size_t i = 0; i < mag.size(); ++i) {
-      if (!roll_pitch[i]) continue;
-      used.push_back(mag[i]);
-      used_rp.push_back(*roll_pitch[i]);
+  try {
+    if (two_axis) {
+      // Only the samples with an attitude enter the tilt-gated fit.
+      std::vector<MagSample> used;
+      std::vector<Eigen::Vector2d> used_rp;
+      for (std::size_t i = 0; i < mag.size(); ++i) {
+        if (!roll_pitch[i]) continue;
+        used.push_back(mag[i]);
+        used_rp.push_back(*roll_pitch[i]);
+      }
+      if (used.size() < mag.size()) {
+        std::cerr << "calibrate-mag: " << mag.size() - used.size()
+                  << " samples outside the attitude record (" << (FLAGS_truth.empty() ? FLAGS_imu : FLAGS_truth)
+                  << ") are left out\n";
+      }
+      c = calibration::FitBidirectional(used, used_rp);
+    } else if (FLAGS_method == "planar") {
+      c = calibration::FitPlanar(mag);
+    } else {
+      calibration::EllipsoidFitOptions options;
+      options.field_uT = FLAGS_field_uT;
+      c = calibration::FitEllipsoid(mag, options);
     }
-    if (used.size() < mag.size()) {
-      std::cerr << "calibrate-mag: " << mag.size() - used.size()
-                << " samples outside the attitude record (" << (FLAGS_truth.empty() ? FLAGS_imu : FLAGS_truth)
-                << ") are left out\n";
-    }
-    c = calibration::FitBidirectional(used, used_rp);
-  } else {
-    calibration::EllipsoidFitOptions options;
-    options.field_uT = FLAGS_field_uT;
-    c = calibration::FitEllipsoid(mag, options);
+  } catch (const std::runtime_error& e) {  // data that cannot calibrate: the reason, with what was read
+    std::cerr << "navtwin calibrate-mag: refused (" << mag.size() << " samples, |m| spread "
+              << Fixed(MagnitudeSpread(mag), 4) << " uT): " << e.what() << "\n";
+    return kExitFailure;
   }
   const HeadingErrors heading = HeadingError(mag, truth, c, two_axis, FLAGS_declination_deg * kDegToRad);
   if (!FLAGS_truth.empty() && heading.samples == 0) {
@@ -293,9 +344,11 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
 
 Command CalibrateMagCommand() {
   return {"calibrate-mag",
-          "Magnetometer hard and soft iron: 3-axis ellipsoid fit or the 2-axis bidirectional method",
-          "navtwin calibrate-mag --mag F --method ellipsoid|bidirectional [--imu F] [--truth NAV] "
+          "Magnetometer hard and soft iron: 3-axis ellipsoid fit, planar fit or the 2-axis bidirectional method",
+          "navtwin calibrate-mag --mag F --method ellipsoid|planar|bidirectional [--imu F] [--truth NAV] "
           "[--declination_deg D] [--field_uT B] [--out FILE] [--format=json]\n"
+          "  planar: 3-axis data near one plane (a level turn in any sensor plane); the axis normal to\n"
+          "  the plane is not calibrated (reported as uncalibrated_axis_sensor).\n"
           "  Roll and pitch come from --truth, else the --imu accelerometer, else level; the heading error\n"
           "  before and after needs --truth (else n/a). --out writes the calibration file\n"
           "  (docs/calibration-file.md) that --calibration applies. Data that cannot calibrate (too little\n"

@@ -3,14 +3,18 @@
 #include "problems/calibration/mag_calibration.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ceres/ceres.h>
+#include <ceres/manifold.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
@@ -33,6 +37,8 @@ constexpr double kRecursiveScale_uT = 50.0;
 /// against the information of one sample (~1), so the recursive estimate equals the batch
 /// algebraic least squares after a few samples.
 constexpr double kRecursiveP0 = 1e6;
+/// 5 unknowns of the planar fit (centre 2, symmetric 2x2 correction 3), overdetermined.
+constexpr int kMinPlanarSamples = 12;
 /// The bidirectional phase is read from the samples within this angle of each x extreme.
 constexpr double kPhaseWindowRad = 15.0 * kDegToRad;
 /// Largest accepted heading gap of the 2-axis turn (both extremes of both axes must be seen).
@@ -44,6 +50,16 @@ constexpr int kMinBidirectionalSamples = 8;
 constexpr double kMaxCorrectionAxisRatio = 2.0;
 /// ... and a hard iron whose sigma exceeds this fraction of the field is not determined.
 constexpr double kMaxHardIronSigmaFraction = 0.05;
+/// The 2-axis limits that follow from the same axis ratio k = 2 (the x/y plane of a
+/// symmetric soft iron): the y/x scale lies in [1/k, k]; the x/y phase is largest with the
+/// principal axes at 45 deg, where sin(phase) = (k^2 - 1) / (k^2 + 1) = 0.6 (36.9 deg).
+constexpr double kMaxBidirectionalSinPhase =
+    (kMaxCorrectionAxisRatio * kMaxCorrectionAxisRatio - 1.0) / (kMaxCorrectionAxisRatio * kMaxCorrectionAxisRatio + 1.0);
+/// Largest angle between the data's plane normal and sensor z for the 2-axis method: the
+/// soft iron it accepts tilts the plane of the readings by a few degrees; a plane 20 deg
+/// off is a sensor (or mounting) tilt, worth ~28 deg of heading error at 57 deg
+/// inclination (TiltErrorBound), or a different sensor plane altogether (FitPlanar).
+constexpr double kMaxBidirectionalPlaneTiltRad = 20.0 * kDegToRad;
 
 std::string Vec(const Eigen::Vector3d& v) {
   std::ostringstream s;
@@ -168,6 +184,25 @@ std::unique_ptr<ceres::LossFunction> MakeLoss(MagLoss loss, double scale_uT) {
   return nullptr;
 }
 
+/// Largest gap (rad) between angles on the circle; 2 pi for fewer than 2 angles.
+double LargestGap(std::vector<double> angles_rad) {
+  if (angles_rad.size() < 2) return 2.0 * M_PI;
+  std::sort(angles_rad.begin(), angles_rad.end());
+  double gap = angles_rad.front() + 2.0 * M_PI - angles_rad.back();
+  for (std::size_t i = 1; i < angles_rad.size(); ++i) gap = std::max(gap, angles_rad[i] - angles_rad[i - 1]);
+  return gap;
+}
+
+/// Sample mean and covariance of the readings.
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> MeanCovariance(const std::vector<MagSample>& samples) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const MagSample& s : samples) mean += s.m_b_uT;
+  mean /= static_cast<double>(samples.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const MagSample& s : samples) cov += (s.m_b_uT - mean) * (s.m_b_uT - mean).transpose();
+  return {mean, cov / static_cast<double>(samples.size())};
+}
+
 std::vector<double> Magnitudes(const std::vector<MagSample>& samples) {
   std::vector<double> out;
   out.reserve(samples.size());
@@ -193,12 +228,7 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
   CheckSamplesFinite(samples, "FitEllipsoid");
 
   // 1. Spread of the raw samples about their mean (one plane -> no calibration of its normal).
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const MagSample& s : samples) mean += s.m_b_uT;
-  mean /= n;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const MagSample& s : samples) cov += (s.m_b_uT - mean) * (s.m_b_uT - mean).transpose();
-  cov /= n;
+  const auto [mean, cov] = MeanCovariance(samples);
   const Spread spread = SpreadOfCovariance(cov);
   if (spread.ratio < options.min_coverage) ThrowPlanar("FitEllipsoid", spread, options.min_coverage);
   const double scale_uT = std::sqrt(cov.trace());  // ~ the radius: monomials of x near 1
@@ -384,8 +414,226 @@ MagCalibration RecursiveEllipsoidFit::Current() const {
     throw std::runtime_error("RecursiveEllipsoidFit: " + why + " after " + std::to_string(count_) +
                              " samples; the samples cover too little of the sphere or are too noisy");
   }
+  c.hard_iron_sigma_uT.setConstant(std::numeric_limits<double>::quiet_NaN());  // not estimated
+  c.correction_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
   c.samples = count_;
   c.method = "recursive";
+  return c;
+}
+
+// ------------------------------------------------------------------------ planar (3-axis, one plane)
+
+// Data near one plane (a level turn of a 3-axis sensor, in whatever sensor plane):
+// 1. plane: mean m_bar and scatter C of the samples; n = the eigenvector of C's smallest
+//    eigenvalue (sign: n . m_bar >= 0, for a level turn the vertical field's direction),
+//    in-plane basis U = [u, v] with u the largest eigenvector and v = n x u (u x v = n);
+//    p_i = U^T (m_i - m_bar).
+// 2. algebraic start in x = p / s (s = RMS in-plane distance): the conic
+//    x^T M x + 2 w^T x = 1 by linear least squares, centre c = -M^-1 w, Q = M / (1 + c^T M c)
+//    positive definite, A_unit = Q^(1/2) / s; the radius R = det(A_unit)^(-1/2) (geometric
+//    mean of the semi-axes) and A2 = R A_unit, centre s c.
+// 3. geometric least squares r_i = |A2 (p_i - c)| - R with R held (MagEllipsoid on (p, 0)
+//    with h_z and A's third row/column held: the same residual in 2-D), robust loss.
+// 4. checks: A2 positive definite; the directions A2 (p_i - c) cover >= min_coverage_deg;
+//    the axis ratio of A2 <= kMaxCorrectionAxisRatio; sigma(c) <= kMaxHardIronSigmaFraction R.
+// 5. lift to sensor axes: h = U (U^T m_bar + c) (no component along n),
+//    A = U A2 U^T + n n^T (identity along n); sigmas propagated from the 5x5 sandwich
+//    covariance (as FitEllipsoid's): Cov(h) = U Cov(c) U^T, Cov(A) = J Cov(A2) J^T.
+MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitOptions& options) {
+  if (options.loss != MagLoss::kNone && (!(options.loss_scale_uT > 0.0) || !std::isfinite(options.loss_scale_uT))) {
+    throw std::invalid_argument("FitPlanar: loss_scale_uT must be positive and finite");
+  }
+  if (options.max_iterations < 1) throw std::invalid_argument("FitPlanar: max_iterations must be >= 1");
+  if (!(options.min_coverage_deg > 0.0 && options.min_coverage_deg <= 360.0)) {
+    throw std::invalid_argument("FitPlanar: min_coverage_deg must be in (0, 360]");
+  }
+  if (!(options.max_out_of_plane > 0.0) || !std::isfinite(options.max_out_of_plane)) {
+    throw std::invalid_argument("FitPlanar: max_out_of_plane must be positive and finite");
+  }
+  const int n = static_cast<int>(samples.size());
+  if (n < kMinPlanarSamples) {
+    throw std::invalid_argument("FitPlanar: too few samples: " + std::to_string(n) + " (need at least " +
+                                std::to_string(kMinPlanarSamples) + " for 5 unknowns)");
+  }
+  CheckSamplesFinite(samples, "FitPlanar");
+
+  // 1. The plane.
+  const auto [mean, cov] = MeanCovariance(samples);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  const double in_plane_var = eig.eigenvalues()(1) + eig.eigenvalues()(2);
+  if (!(eig.eigenvalues()(1) > 0.0)) throw std::runtime_error("FitPlanar: the samples lie on a line or a point");
+  Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  if (normal.dot(mean) < 0.0) normal = -normal;
+  Eigen::Matrix<double, 3, 2> U;
+  U.col(0) = eig.eigenvectors().col(2);
+  U.col(1) = normal.cross(U.col(0));
+  std::vector<Eigen::Vector2d> p(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) p[i] = U.transpose() * (samples[i].m_b_uT - mean);
+  const double scale_uT = std::sqrt(in_plane_var);
+
+  // 2. Algebraic conic.
+  Eigen::Matrix<double, 5, 5> normal_eq = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> rhs = Eigen::Matrix<double, 5, 1>::Zero();
+  for (const Eigen::Vector2d& pi : p) {
+    const Eigen::Vector2d x = pi / scale_uT;
+    Eigen::Matrix<double, 5, 1> phi;
+    phi << x.x() * x.x(), x.y() * x.y(), 2.0 * x.x() * x.y(), 2.0 * x.x(), 2.0 * x.y();
+    normal_eq.selfadjointView<Eigen::Lower>().rankUpdate(phi);
+    rhs += phi;
+  }
+  normal_eq = normal_eq.selfadjointView<Eigen::Lower>();
+  const Eigen::Matrix<double, 5, 1> t = normal_eq.ldlt().solve(rhs);
+  Eigen::Matrix2d M;
+  M << t(0), t(2), t(2), t(1);
+  const Eigen::Vector2d w = t.tail<2>();
+  const double det_m = M.determinant();
+  const Eigen::Vector2d centre_unit = det_m != 0.0 ? Eigen::Vector2d(-M.inverse() * w) : Eigen::Vector2d::Zero();
+  const double k = 1.0 + centre_unit.dot(M * centre_unit);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig_q(M / k);
+  if (!(det_m > 0.0) || !(k > 0.0) || !(eig_q.eigenvalues()(0) > 0.0) || !t.allFinite()) {
+    throw std::runtime_error("FitPlanar: the in-plane readings do not lie on an ellipse: they cover too little of "
+                             "the circle (turn through a full 360 deg in the plane)");
+  }
+  const Eigen::Matrix2d A_unit = eig_q.eigenvectors() * eig_q.eigenvalues().cwiseSqrt().asDiagonal() *
+                                 eig_q.eigenvectors().transpose() / scale_uT;
+  const double R = 1.0 / std::sqrt(A_unit.determinant());
+  const double out_of_plane_rms_uT = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
+  if (out_of_plane_rms_uT > options.max_out_of_plane * R) {
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "FitPlanar: the samples are not near one plane (RMS " << out_of_plane_rms_uT << " uT off the plane > "
+        << options.max_out_of_plane << " of the in-plane radius " << R
+        << " uT): the sensor tilts too much for a planar calibration; use the ellipsoid fit";
+    throw std::runtime_error(msg.str());
+  }
+
+  // 3. Geometric least squares on (p, 0) with the z parts held.
+  double h[3] = {scale_uT * centre_unit.x(), scale_uT * centre_unit.y(), 0.0};
+  const Eigen::Matrix2d A2_start = R * A_unit;
+  double a[6] = {A2_start(0, 0), A2_start(0, 1), 0.0, A2_start(1, 1), 0.0, 1.0};
+  double B = R;
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // loss is used after the solve
+  ceres::Problem problem(problem_options);
+  const std::unique_ptr<ceres::LossFunction> loss = MakeLoss(options.loss, options.loss_scale_uT);
+  std::vector<ceres::ResidualBlockId> blocks;
+  blocks.reserve(samples.size());
+  for (const Eigen::Vector2d& pi : p) {
+    blocks.push_back(problem.AddResidualBlock(MagEllipsoid::Create(Eigen::Vector3d(pi.x(), pi.y(), 0.0), 1.0),
+                                              loss.get(), h, a, &B));
+  }
+  problem.SetManifold(h, new ceres::SubsetManifold(3, {2}));
+  problem.SetManifold(a, new ceres::SubsetManifold(6, {2, 4, 5}));
+  problem.SetParameterBlockConstant(&B);
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  if (!summary.IsSolutionUsable()) {
+    throw std::runtime_error("FitPlanar: the least-squares solve failed: " + summary.message);
+  }
+  const Eigen::Vector2d centre(h[0], h[1]);
+  Eigen::Matrix2d A2;
+  A2 << a[0], a[1], a[1], a[3];
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig_a(A2);
+  if (!centre.allFinite() || !A2.allFinite() || !(eig_a.eigenvalues()(0) > 0.0)) {
+    throw std::runtime_error("FitPlanar: the fit did not give a positive-definite correction: the samples cover "
+                             "too little of the circle (or too many are outliers)");
+  }
+
+  // 4. Coverage (first: an arc is the usual cause of an implausible ellipse) and plausibility.
+  std::vector<double> angles;
+  angles.reserve(p.size());
+  for (const Eigen::Vector2d& pi : p) {
+    const Eigen::Vector2d d = A2 * (pi - centre);
+    angles.push_back(std::atan2(d.y(), d.x()));
+  }
+  const double coverage_deg = 360.0 - LargestGap(angles) * kRadToDeg;
+  if (coverage_deg < options.min_coverage_deg) {
+    throw std::runtime_error("FitPlanar: the in-plane field directions cover only " + std::to_string(coverage_deg) +
+                             " deg of the circle (need " + std::to_string(options.min_coverage_deg) +
+                             "): turn through a full 360 deg in the plane");
+  }
+
+  const double axis_ratio = eig_a.eigenvalues()(1) / eig_a.eigenvalues()(0);
+  if (axis_ratio > kMaxCorrectionAxisRatio) {
+    throw std::runtime_error("FitPlanar: implausible soft iron (the in-plane correction's axes differ by a factor " +
+                             std::to_string(axis_ratio) + " > " + std::to_string(kMaxCorrectionAxisRatio) +
+                             "): an arc of the circle fitted by a distorted ellipse; turn through a full 360 deg");
+  }
+
+  // Sandwich covariance of (c, A2) as in FitEllipsoid: columns h0, h1, a0, a1, a3.
+  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  using Matrix5d = Eigen::Matrix<double, 5, 5>;
+  Matrix5d H = Matrix5d::Zero(), G = Matrix5d::Zero();
+  double ss = 0.0;
+  int downweighted = 0;
+  std::vector<double> before, after;
+  before.reserve(p.size());
+  after.reserve(p.size());
+  const double* parameters[] = {h, a, &B};
+  const Eigen::Vector2d mean_in_plane = U.transpose() * mean;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double r = 0.0;
+    Eigen::Matrix<double, 1, 3, Eigen::RowMajor> jh;
+    Eigen::Matrix<double, 1, 6, Eigen::RowMajor> ja;
+    double* jacobians[] = {jh.data(), ja.data(), nullptr};
+    problem.GetCostFunctionForResidualBlock(blocks[i])->Evaluate(parameters, &r, jacobians);
+    Vector5d j;
+    j << jh(0), jh(1), ja(0), ja(1), ja(3);
+    double rho[3] = {r * r, 1.0, 0.0};
+    if (loss) loss->Evaluate(r * r, rho);
+    if (rho[1] < 0.5) ++downweighted;
+    H.selfadjointView<Eigen::Lower>().rankUpdate(j, std::max(0.0, rho[1] + 2.0 * r * r * rho[2]));
+    G.selfadjointView<Eigen::Lower>().rankUpdate(j, (rho[1] * r) * (rho[1] * r));
+    ss += r * r;
+    before.push_back((mean_in_plane + p[i]).norm());
+    after.push_back(r + B);
+  }
+  H = H.selfadjointView<Eigen::Lower>();
+  G = G.selfadjointView<Eigen::Lower>();
+  const Eigen::LDLT<Matrix5d> ldlt(H);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
+    throw std::runtime_error("FitPlanar: the parameters are not observable from these samples "
+                             "(information matrix singular)");
+  }
+  const Matrix5d H_inv = ldlt.solve(Matrix5d::Identity());
+  const Matrix5d covariance = H_inv * G * H_inv * (static_cast<double>(n) / (n - 5));
+  const double centre_sigma = std::sqrt(std::max(covariance(0, 0), covariance(1, 1)));
+  if (centre_sigma > kMaxHardIronSigmaFraction * R) {
+    throw std::runtime_error("FitPlanar: the in-plane hard iron is not determined by these samples (sigma " +
+                             std::to_string(centre_sigma) + " uT > " + std::to_string(kMaxHardIronSigmaFraction) +
+                             " of the in-plane field)");
+  }
+
+  // 5. Lift to sensor axes.
+  MagCalibration c;
+  c.hard_iron_uT = U * (mean_in_plane + centre);
+  c.correction = U * A2 * U.transpose() + normal * normal.transpose();
+  c.field_uT = R;
+  c.hard_iron_sigma_uT = (U * covariance.topLeftCorner<2, 2>() * U.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
+  // d(U A2 U^T)/d(a0, a1, a3) in the order A00 A01 A02 A11 A12 A22.
+  const std::array<Eigen::Matrix3d, 3> dA = {U.col(0) * U.col(0).transpose(),
+                                             U.col(0) * U.col(1).transpose() + U.col(1) * U.col(0).transpose(),
+                                             U.col(1) * U.col(1).transpose()};
+  Eigen::Matrix<double, 6, 3> J;
+  for (int q = 0; q < 3; ++q) {
+    J.col(q) << dA[q](0, 0), dA[q](0, 1), dA[q](0, 2), dA[q](1, 1), dA[q](1, 2), dA[q](2, 2);
+  }
+  c.correction_sigma =
+      (J * covariance.bottomRightCorner<3, 3>() * J.transpose()).diagonal().cwiseMax(0.0).cwiseSqrt();
+  c.uncalibrated_axis = normal;
+  c.residual_rms_uT = std::sqrt(ss / n);
+  c.field_spread_before_uT = MeanStd(before).second;
+  c.field_spread_after_uT = MeanStd(after).second;
+  c.samples = n;
+  c.downweighted = downweighted;
+  c.method = "planar";
+  c.coverage_deg = coverage_deg;
+  c.out_of_plane_rms_uT = out_of_plane_rms_uT;
   return c;
 }
 
@@ -416,12 +664,14 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
   CheckSamplesFinite(samples, "FitBidirectional");
   const double max_tilt_rad = options.max_tilt_deg * kDegToRad;
   std::vector<Eigen::Vector2d> xy;
+  std::vector<MagSample> used;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (!roll_pitch_rad[i].allFinite()) {
       throw std::invalid_argument("FitBidirectional: roll/pitch of sample " + std::to_string(i) + " is not finite");
     }
     if (std::abs(roll_pitch_rad[i].x()) <= max_tilt_rad && std::abs(roll_pitch_rad[i].y()) <= max_tilt_rad) {
       xy.push_back(samples[i].m_b_uT.head<2>());
+      used.push_back(samples[i]);
     }
   }
   if (static_cast<int>(xy.size()) < kMinBidirectionalSamples) {
@@ -429,6 +679,16 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
                              std::to_string(options.max_tilt_deg) + " deg: " + std::to_string(xy.size()) + " of " +
                              std::to_string(samples.size()) + " (need at least " +
                              std::to_string(kMinBidirectionalSamples) + ")");
+  }
+  // The data's plane must be the sensor's x/y plane (a 2-axis sensor reads z = 0: normal z).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(MeanCovariance(used).second);
+  const Eigen::Vector3d normal = eig.eigenvectors().col(0);
+  const double plane_tilt_rad = std::acos(std::min(1.0, std::abs(normal.z())));
+  if (plane_tilt_rad > kMaxBidirectionalPlaneTiltRad) {
+    throw std::runtime_error("FitBidirectional: the readings' plane is not the sensor's x/y plane (its normal " +
+                             Vec(normal) + " is " + std::to_string(plane_tilt_rad * kRadToDeg) + " deg from z, limit " +
+                             std::to_string(kMaxBidirectionalPlaneTiltRad * kRadToDeg) +
+                             "): the turn is in another sensor plane; use --method planar (FitPlanar)");
   }
   Eigen::Vector2d lo = xy.front(), hi = xy.front();
   for (const Eigen::Vector2d& p : xy) {
@@ -438,15 +698,20 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
   const Eigen::Vector2d offset = 0.5 * (hi + lo);
   const Eigen::Vector2d amplitude = 0.5 * (hi - lo);
   if (!(amplitude.minCoeff() > 0.0)) throw std::runtime_error("FitBidirectional: an axis reads a constant");
+  const double y_over_x = amplitude.y() / amplitude.x();
+  if (y_over_x > kMaxCorrectionAxisRatio || y_over_x < 1.0 / kMaxCorrectionAxisRatio) {
+    throw std::runtime_error("FitBidirectional: implausible y/x scale " + std::to_string(y_over_x) +
+                             " (soft iron within an axis ratio of " + std::to_string(kMaxCorrectionAxisRatio) +
+                             " gives [" + std::to_string(1.0 / kMaxCorrectionAxisRatio) + ", " +
+                             std::to_string(kMaxCorrectionAxisRatio) + "]): not a level turn in the x/y plane");
+  }
   // Coverage: the angles of the normalised readings must leave no gap above kMaxHeadingGapRad.
   std::vector<double> angles;
   angles.reserve(xy.size());
   for (const Eigen::Vector2d& p : xy) {
     angles.push_back(std::atan2(-(p.y() - offset.y()) / amplitude.y(), (p.x() - offset.x()) / amplitude.x()));
   }
-  std::sort(angles.begin(), angles.end());
-  double gap = angles.front() + 2.0 * M_PI - angles.back();
-  for (std::size_t i = 1; i < angles.size(); ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
+  const double gap = LargestGap(angles);
   if (gap > kMaxHeadingGapRad) {
     throw std::runtime_error("FitBidirectional: the turn does not cover both extremes of both axes (a heading gap of " +
                              std::to_string(gap / kDegToRad) + " deg; turn through a full 360 deg, level)");
@@ -470,9 +735,11 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
   if (n_max == 0 || n_min == 0) throw std::runtime_error("FitBidirectional: no samples near an x extreme");
   const double cos_t = (x_max_sum / n_max - x_min_sum / n_min) / (2.0 * amplitude.x());
   const double sin_phase = (y_min_sum / n_min - y_max_sum / n_max) / (2.0 * amplitude.y()) / cos_t;
-  if (!(std::abs(sin_phase) < 0.95)) {
-    throw std::runtime_error("FitBidirectional: the x/y phase is not measurable (sin = " + std::to_string(sin_phase) +
-                             "): the axes are nearly parallel or the samples too noisy");
+  if (!(std::abs(sin_phase) <= kMaxBidirectionalSinPhase)) {
+    throw std::runtime_error("FitBidirectional: implausible x/y phase (sin = " + std::to_string(sin_phase) +
+                             ", |phase| > " + std::to_string(std::asin(kMaxBidirectionalSinPhase) * kRadToDeg) +
+                             " deg, the most a soft-iron axis ratio of " + std::to_string(kMaxCorrectionAxisRatio) +
+                             " gives): the axes are nearly parallel or the samples too noisy");
   }
   const double phase = std::asin(sin_phase);
 
@@ -482,6 +749,10 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
   c.correction(1, 0) = std::tan(phase);
   c.correction(1, 1) = amplitude.x() / amplitude.y() / std::cos(phase);
   c.field_uT = amplitude.x();
+  c.hard_iron_sigma_uT.setConstant(std::numeric_limits<double>::quiet_NaN());  // not estimated
+  c.correction_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
+  c.uncalibrated_axis = Eigen::Vector3d::UnitZ();
+  c.coverage_deg = 360.0 - gap * kRadToDeg;
   std::vector<double> before, after;
   double ss = 0.0;
   for (const Eigen::Vector2d& p : xy) {

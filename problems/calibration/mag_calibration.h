@@ -16,6 +16,12 @@
 //    missing (e.g. "all samples near one plane: the axis normal to it is not calibrated").
 //  - RecursiveEllipsoidFit (3-axis, recursive): recursive least squares on the algebraic
 //    quadric parameters as samples arrive, with the same calibration available at any time.
+//  - FitPlanar (3-axis data near one plane: a level flight or a level turn, in whatever
+//    sensor plane): the plane from the smallest-eigenvalue direction n of the scatter, then
+//    in the plane's 2-D coordinates a centre and a symmetric 2x2 correction (ellipse ->
+//    circle; Ceres, robust loss, sandwich sigmas as FitEllipsoid). Lifted to 3-D with the
+//    component along n left uncalibrated (hard iron 0 and A identity along n). Refuses
+//    when the in-plane directions cover < 270 deg or the ellipse is implausible.
 //  - FitBidirectional (the seed's 2-axis method): from a level turn of a 2-axis sensor, hard
 //    iron as the midpoint of opposite readings (pairs 180 deg apart in heading:
 //    h = (m(psi) + m(psi + 180))/2, taken from the extremes of each axis), soft iron as the
@@ -40,14 +46,28 @@ struct MagCalibration {
   Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();  ///< h
   Eigen::Matrix3d correction = Eigen::Matrix3d::Identity();  ///< A (symmetric for the ellipsoid fit)
   double field_uT = 0.0;                                     ///< B
+  /// 1-sigma of h and of A (A00 A01 A02 A11 A12 A22); NaN where not estimated (the
+  /// bidirectional method and the recursive fit give none).
   Eigen::Vector3d hard_iron_sigma_uT = Eigen::Vector3d::Zero();
-  Eigen::Matrix<double, 6, 1> correction_sigma = Eigen::Matrix<double, 6, 1>::Zero();  ///< A00 A01 A02 A11 A12 A22
+  Eigen::Matrix<double, 6, 1> correction_sigma = Eigen::Matrix<double, 6, 1>::Zero();
+  /// Unit vector (sensor axes) along which nothing is calibrated (h has no component along
+  /// it and A maps it to itself): the plane normal of FitPlanar, z for FitBidirectional;
+  /// zero for the 3-axis fits, which calibrate every axis.
+  Eigen::Vector3d uncalibrated_axis = Eigen::Vector3d::Zero();
   double residual_rms_uT = 0.0;        ///< RMS of |A (m - h)| - B over the samples used
-  double field_spread_before_uT = 0.0; ///< std of |m| before calibration
-  double field_spread_after_uT = 0.0;  ///< std of |A (m - h)| after
+  /// std of |m| before and of |A (m - h)| after calibration; for the planar and 2-axis
+  /// methods the magnitudes of the in-plane part only (the component along
+  /// uncalibrated_axis is left out, before and after).
+  double field_spread_before_uT = 0.0;
+  double field_spread_after_uT = 0.0;
   int samples = 0;
   int downweighted = 0;                ///< robust weight < 0.5
-  std::string method;                  ///< "ellipsoid", "recursive", "bidirectional"
+  std::string method;                  ///< "ellipsoid", "recursive", "planar", "bidirectional"
+  /// Planar and 2-axis: the angle (deg) covered by the in-plane field directions after
+  /// calibration (360 minus the largest gap); 0 for the 3-axis fits.
+  double coverage_deg = 0.0;
+  /// Planar: RMS distance of the samples from the fitted plane (uT); 0 otherwise.
+  double out_of_plane_rms_uT = 0.0;
 };
 
 /// A (m - h).
@@ -84,6 +104,28 @@ class RecursiveEllipsoidFit {
   Eigen::Matrix<double, 9, 1> theta_;
 };
 
+struct PlanarFitOptions {
+  MagLoss loss = MagLoss::kCauchy;
+  double loss_scale_uT = 2.0;
+  int max_iterations = 50;
+  /// Smallest accepted angle covered by the in-plane directions (deg): with a gap below
+  /// 90 deg, at most one of the four extremes of any pair of in-plane axes is unseen, so
+  /// both extremes of one axis and at least one of the other bound the centre and the shape.
+  double min_coverage_deg = 270.0;
+  /// Largest accepted RMS distance from the plane as a fraction of the in-plane radius R:
+  /// a tilt t about a horizontal axis at a random angle moves a sample out of the plane by
+  /// R t / sqrt(2) RMS, so 0.15 is ~12 deg of tilt (a heading error of ~18 deg at 57 deg
+  /// inclination, TiltErrorBound): beyond it the data are not one plane (use FitEllipsoid).
+  double max_out_of_plane = 0.15;
+};
+
+/// Planar calibration of a 3-axis sensor from data near one plane (any sensor plane). The
+/// plane normal n is the smallest-eigenvalue direction of the sample scatter; field_uT is the
+/// circle radius (the field component in that plane, e.g. the horizontal field for a level
+/// turn). Throws std::invalid_argument for bad input (too few samples, NaN, bad options),
+/// std::runtime_error naming what is missing when the data cannot calibrate.
+MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitOptions& options = {});
+
 struct BidirectionalOptions {
   double max_tilt_deg = 2.0;  ///< samples with |roll| or |pitch| above this are left out
 };
@@ -92,7 +134,9 @@ struct BidirectionalOptions {
 /// deg; roll_pitch_rad[i] = (roll, pitch) of sample i (from the IMU; zeros if level).
 /// correction = [[1, 0, 0], [-sin(phase) * k, cos(phase) * k, 0], [0, 0, 1]]-style 2x2 block
 /// documented in the implementation. Throws std::runtime_error when the turn does not cover
-/// both extremes of both axes.
+/// both extremes of both axes, when the y/x scale or the phase is implausible (beyond what
+/// a correction axis ratio of 2 gives: scale outside [1/2, 2], |phase| > 36.9 deg) or when
+/// the data's plane is not the sensor's x/y plane (normal > 20 deg from z: use FitPlanar).
 MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std::vector<Eigen::Vector2d>& roll_pitch_rad,
                                 const BidirectionalOptions& options = {});
 

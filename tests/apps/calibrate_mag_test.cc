@@ -1,6 +1,7 @@
 // End-to-end checks of `navtwin calibrate-mag`: a simulated rate table turning about every
 // axis with hard and soft iron (ellipsoid fit, heading against the truth), a simulated level
-// turn of a 2-axis sensor (bidirectional), the calibration file it writes, and bad input
+// turn of a 2-axis sensor (bidirectional), a level turn of a 3-axis sensor (planar), the
+// calibration file it writes, and bad input
 // (exit non-zero, a message naming file, line and field, no output file).
 #include <cmath>
 #include <cstdio>
@@ -43,6 +44,15 @@ Eigen::Vector3d Array3(const std::string& json, const std::string& key = "hard_i
   const std::size_t at = json.find(anchor);
   if (at != std::string::npos) std::sscanf(json.c_str() + at + anchor.size(), "%lf,%lf,%lf", &h[0], &h[1], &h[2]);
   return h;
+}
+
+/// A level 390 deg turn at 30 deg/s; `mag` is the scenario's mag section.
+std::string LevelTurn(const std::string& mag) {
+  return "name: mag-turn\nduration_s: 30\nstart: {lat_deg: 37.45, lon_deg: 126.65, h_m: 20}\n"
+         "trajectory:\n  kind: multiposition\n  rotation_s: 3\n  dwell_s: 1\n  steps:\n"
+         "    - euler_deg: [0, 0, 0]\n    - {rotate: yaw, rate_deg_s: 30, duration_s: 13, ramp_s: 1}\n"
+         "imu: {rate_hz: 100}\n" +
+         mag;
 }
 
 const char* const kMagSection =
@@ -118,13 +128,9 @@ TEST_F(CalibrateMagTest, EllipsoidOnARateTableRecoversTheHardIronAndTheHeading) 
 }
 
 TEST_F(CalibrateMagTest, BidirectionalOnALevelTurnOfA2AxisSensor) {
-  Simulate("turn",
-           "name: mag-turn\nduration_s: 30\nstart: {lat_deg: 37.45, lon_deg: 126.65, h_m: 20}\n"
-           "trajectory:\n  kind: multiposition\n  rotation_s: 3\n  dwell_s: 1\n  steps:\n"
-           "    - euler_deg: [0, 0, 0]\n    - {rotate: yaw, rate_deg_s: 30, duration_s: 13, ramp_s: 1}\n"
-           "imu: {rate_hz: 100}\n"
-           "mag:\n  rate_hz: 20\n  declination_deg: -8.5\n  noise_uT: 0.1\n  two_axis: true\n"
-           "  hard_iron_fixed_uT: [12, -7, 0]\n  soft_iron_fixed: [[0.05, 0.03, 0], [0.03, -0.03, 0], [0, 0, 0]]\n");
+  Simulate("turn", LevelTurn("mag:\n  rate_hz: 20\n  declination_deg: -8.5\n  noise_uT: 0.1\n  two_axis: true\n"
+                              "  hard_iron_fixed_uT: [12, -7, 0]\n"
+                              "  soft_iron_fixed: [[0.05, 0.03, 0], [0.03, -0.03, 0], [0, 0, 0]]\n"));
   const std::string sim = dir_ + "/turn";
   // Roll and pitch from the accelerometer for the tilt gate; the heading from the truth.
   for (const std::string& attitude : {"--truth " + sim + "/truth.nav", "--imu " + sim + "/imu.txt"}) {
@@ -142,13 +148,52 @@ TEST_F(CalibrateMagTest, BidirectionalOnALevelTurnOfA2AxisSensor) {
       // The 2-axis method models soft iron as a phase and a y/x scale only: a few degrees.
       EXPECT_LT(after, 3.0) << r.out;
     }
+    // The 2-axis method estimates no sigmas and leaves z alone.
+    EXPECT_NE(r.out.find("\"hard_iron_sigma_uT\":[null,null,null]"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\"uncalibrated_axis_sensor\":[0,0,1]"), std::string::npos) << r.out;
   }
+  const RunResult text = Navtwin("calibrate-mag --mag " + sim + "/mag.csv --method bidirectional");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("hard iron sigma [uT]         n/a        n/a        n/a"), std::string::npos) << text.out;
   // A level turn cannot calibrate the third axis: the ellipsoid fit refuses, writes nothing.
   const std::string out = dir_ + "/refused.yaml";
   const RunResult refused = Navtwin("calibrate-mag --mag " + sim + "/mag.csv --method ellipsoid --out " + out);
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find("plane"), std::string::npos) << refused.err;
   EXPECT_FALSE(Exists(out));
+}
+
+// A level turn of a 3-axis sensor: the planar fit calibrates x and y (the soft iron has no
+// x-z or y-z part, so the plane of the readings is the sensor's x/y plane) and leaves z.
+TEST_F(CalibrateMagTest, PlanarOnALevelTurnOfA3AxisSensor) {
+  Simulate("turn3", LevelTurn("mag:\n  rate_hz: 20\n  declination_deg: -8.5\n  noise_uT: 0.1\n"
+                               "  hard_iron_fixed_uT: [12, -7, 4]\n"
+                               "  soft_iron_fixed: [[0.05, 0.03, 0], [0.03, -0.03, 0], [0, 0, 0.02]]\n"));
+  const std::string sim = dir_ + "/turn3";
+  const RunResult r = Navtwin("calibrate-mag --mag " + sim + "/mag.csv --truth " + sim +
+                              "/truth.nav --method planar --declination_deg -8.5 --format=json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Eigen::Vector3d h = Array3(r.out), sigma = Array3(r.out, "hard_iron_sigma_uT");
+  const Eigen::Vector3d n = Array3(r.out, "uncalibrated_axis_sensor");
+  // sigma of the centre: 0.1 uT noise over ~600 samples, ~0.006 uT; 5 sigma each.
+  EXPECT_NEAR(h.x(), 12.0, 5.0 * sigma.x()) << r.out;
+  EXPECT_NEAR(h.y(), -7.0, 5.0 * sigma.y()) << r.out;
+  // Not calibrated along the normal: no hard iron along it by convention (JSON numbers
+  // have 10 significant digits).
+  EXPECT_NEAR(n.dot(h), 0.0, 1e-8 * h.norm()) << r.out;
+  EXPECT_GT(n.z(), 0.9999) << r.out;  // the plane normal (down: the vertical field's side)
+  const double before = JsonNumberAfter(r.out, "{", "heading_error_before_deg");
+  const double after = JsonNumberAfter(r.out, "{", "heading_error_after_deg");
+  EXPECT_GT(before, 10.0) << r.out;  // 12 uT of hard iron against ~27 uT horizontal field
+  // Noise 0.1 uT over 27 uT is 0.2 deg; the symmetric in-plane correction models this soft
+  // iron exactly: 0.5 deg.
+  EXPECT_LT(after, 0.5) << r.out;
+  EXPECT_LT(JsonNumberAfter(r.out, "{", "field_spread_after_uT"), 0.12) << r.out;  // the noise
+  EXPECT_NE(r.out.find("\"spread_of\":\"in-plane |m|\""), std::string::npos) << r.out;
+  const RunResult text = Navtwin("calibrate-mag --mag " + sim + "/mag.csv --method planar");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("NOT calibrated along"), std::string::npos) << text.out;
+  EXPECT_EQ(Navtwin("calibrate-mag --mag " + sim + "/mag.csv --method planar --field_uT 50").exit_code, 2);
 }
 
 TEST_F(CalibrateMagTest, BadInputNamesFileLineAndFieldAndWritesNothing) {

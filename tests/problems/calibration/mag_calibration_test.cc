@@ -389,6 +389,143 @@ TEST(FitBidirectional, RejectsAPartialTurnAndTooMuchTilt) {
   EXPECT_THROW(FitBidirectional(turn.samples, half_rp), std::invalid_argument);  // sizes differ
 }
 
+// ------------------------------------------------------------------------ planar (3-axis, one plane)
+
+/// Sensor axes from body axes for a sensor mounted on its side: body z (down) is sensor -y,
+/// so a level turn lies in the sensor's x/z plane (normal along y).
+Eigen::Matrix3d SensorOnItsSide() { return Eigen::AngleAxisd(M_PI / 2.0, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
+
+struct MountedTurn {
+  std::vector<MagSample> samples;
+  std::vector<double> yaw_rad;
+};
+
+/// A level turn of a 3-axis sensor mounted with R_s_b: m_s = (I + S) R_s_b R_b_n m_n + h + n,
+/// `degrees` of heading at 0.5 deg per sample.
+MountedTurn SimulateMountedTurn(const Iron& iron, const Eigen::Matrix3d& R_s_b, double degrees, double noise_uT,
+                                sim::Rng& rng) {
+  MountedTurn turn;
+  const int n = static_cast<int>(degrees / 0.5);
+  for (int i = 0; i < n; ++i) {
+    const double yaw = WrapPi(0.5 * kDeg * i + 0.3);
+    MagSample s;
+    s.t_s = 0.02 * i;
+    s.m_b_uT = Measure(iron, DcmFromEuler(0.0, 0.0, yaw) * R_s_b.transpose(), noise_uT, rng);
+    turn.samples.push_back(s);
+    turn.yaw_rad.push_back(yaw);
+  }
+  return turn;
+}
+
+TEST(FitPlanar, LevelTurnOfASensorOnItsSideRecoversTheInPlaneHardIronAndTheHeading) {
+  sim::Rng rng(51);
+  const Iron iron = DrawIron(rng);
+  const Eigen::Matrix3d R_s_b = SensorOnItsSide();
+  const MountedTurn turn = SimulateMountedTurn(iron, R_s_b, 720.0, 0.3, rng);
+  const MagCalibration c = FitPlanar(turn.samples);
+  EXPECT_EQ(c.method, "planar");
+  EXPECT_EQ(c.samples, 1440);
+  // The readings lie on the image of the horizontal circle, M = (I + S) R_s_b: the plane
+  // spanned by M e_x, M e_y through o = h + M (0, 0, V) (the vertical field through the soft
+  // iron adds to the offset: only o's in-plane part is measurable, and it is what h calibrates).
+  const Eigen::Matrix3d M = (Eigen::Matrix3d::Identity() + iron.S) * R_s_b;
+  const Eigen::Vector3d n_true = M.col(0).cross(M.col(1)).normalized();
+  const Eigen::Vector3d o = iron.h_uT + M * Eigen::Vector3d(0.0, 0.0, FieldNed().z());
+  const Eigen::Vector3d n = c.uncalibrated_axis;
+  // Plane normal from 1440 samples of 0.3 uT noise over a 27 uT circle: ~1e-3 rad.
+  EXPECT_GT(std::abs(n.dot(n_true)), std::cos(0.5 * kDeg)) << n.transpose() << " vs " << n_true.transpose();
+  EXPECT_GT(std::abs(n.y()), std::cos(15.0 * kDeg));  // about the sensor's y axis (S tilts it a little)
+  EXPECT_NEAR(n.dot(c.hard_iron_uT), 0.0, 1e-9);      // no hard iron along the normal
+  EXPECT_NEAR((c.correction * n - n).norm(), 0.0, 1e-9);  // A identity along it
+  const Eigen::Vector3d h_error = (Eigen::Matrix3d::Identity() - n * n.transpose()) * (c.hard_iron_uT - o);
+  std::cout << "[planar] in-plane |h error| " << h_error.norm() << " uT, sigma (" << c.hard_iron_sigma_uT.transpose()
+            << ") uT, coverage " << c.coverage_deg << " deg, in-plane |m| spread " << c.field_spread_before_uT << " -> "
+            << c.field_spread_after_uT << " uT, off-plane RMS " << c.out_of_plane_rms_uT << " uT\n";
+  // sigma of the centre ~0.3 uT / sqrt(720) = 0.011 uT per axis: 0.06 uT is ~5 sigma.
+  EXPECT_LT(h_error.norm(), 0.06);
+  EXPECT_LT(c.hard_iron_sigma_uT.maxCoeff(), 0.02);
+  // Two full turns at 0.5 deg per sample; noise jitters each direction by ~0.6 deg (0.3 uT
+  // over 27 uT), widening the largest gap to ~1.5 deg.
+  EXPECT_GT(c.coverage_deg, 355.0);
+  EXPECT_GT(c.field_spread_before_uT, 5.0);  // 10-30 uT of hard iron
+  EXPECT_LT(c.field_spread_after_uT, 0.35);  // the 0.3 uT noise (its radial part)
+  EXPECT_TRUE(c.correction_sigma.allFinite());
+
+  // Heading in the plane: the calibrated field without its (raw) normal component, back to
+  // body axes, against the true yaw.
+  double ss_before = 0.0, ss_after = 0.0;
+  for (std::size_t i = 0; i < turn.samples.size(); ++i) {
+    const Eigen::Vector3d& m = turn.samples[i].m_b_uT;
+    Eigen::Vector3d m_c = ApplyMagCalibration(c, m);
+    m_c -= n * n.dot(m_c);
+    const double before = WrapPi(LevelHeading(R_s_b.transpose() * m, 0.0) - turn.yaw_rad[i]);
+    const double after = WrapPi(LevelHeading(R_s_b.transpose() * m_c, 0.0) - turn.yaw_rad[i]);
+    ss_before += before * before;
+    ss_after += after * after;
+  }
+  const double n_samples = static_cast<double>(turn.samples.size());
+  const double rms_before_deg = std::sqrt(ss_before / n_samples) / kDeg, rms_after_deg = std::sqrt(ss_after / n_samples) / kDeg;
+  std::cout << "[planar heading] RMS heading error before " << rms_before_deg << " deg, after " << rms_after_deg
+            << " deg\n";
+  EXPECT_GT(rms_before_deg, 10.0);  // 10-30 uT of hard iron against the 27 uT horizontal field
+  // Noise: 0.3 uT across 27 uT is 0.63 deg RMS; the symmetric in-plane correction leaves a
+  // rotation of O(S^2) ~ 0.15 deg: 1 deg.
+  EXPECT_LT(rms_after_deg, 1.0);
+}
+
+TEST(FitPlanar, HalfATurnAndASphereAreRefused) {
+  sim::Rng rng(52);
+  const Iron iron = DrawIron(rng);
+  const MountedTurn half = SimulateMountedTurn(iron, SensorOnItsSide(), 180.0, 0.3, rng);
+  try {
+    FitPlanar(half.samples);
+    FAIL() << "half a turn cannot calibrate the plane";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("360"), std::string::npos) << e.what();
+  }
+  try {
+    FitPlanar(SphereSamples(iron, 500, 0.3, rng));
+    FAIL() << "a sphere is not one plane";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not near one plane"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(FitPlanar(std::vector<MagSample>(half.samples.begin(), half.samples.begin() + 11)),
+               std::invalid_argument);
+  PlanarFitOptions bad;
+  bad.min_coverage_deg = 400.0;
+  EXPECT_THROW(FitPlanar(half.samples, bad), std::invalid_argument);
+}
+
+TEST(FitBidirectional, RefusesATurnOutsideTheXYPlaneAndImplausibleSoftIron) {
+  sim::Rng rng(33);
+  const Iron iron = DrawIron(rng);
+  // A 3-axis sensor on its side: its level plane is x/z; x/y alone read a line, not a circle.
+  const MountedTurn side = SimulateMountedTurn(iron, SensorOnItsSide(), 720.0, 0.3, rng);
+  try {
+    FitBidirectional(side.samples, std::vector<Eigen::Vector2d>(side.samples.size(), Eigen::Vector2d::Zero()));
+    FAIL() << "the x/y plane is not the plane of the turn";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("planar"), std::string::npos) << e.what();
+  }
+  // y/x scale 0.4 (beyond the axis ratio 2) and a phase of 45 deg (beyond 36.9 deg).
+  for (const auto& [M, expect] : {std::make_pair(TwoAxisIron(1.0, 0.4, 0.0), std::string("y/x scale")),
+                                  std::make_pair(TwoAxisIron(1.0, 1.0, 45.0 * kDeg), std::string("phase"))}) {
+    const LevelTurn turn = SimulateTurn(M, Eigen::Vector3d(5.0, 5.0, 0.0), 0.2, rng);
+    try {
+      FitBidirectional(turn.samples, turn.roll_pitch_rad);
+      FAIL() << expect;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+    }
+  }
+  // Sigmas are not estimated by the 2-axis method: NaN (printed n/a, JSON null).
+  const LevelTurn good = SimulateTurn(TwoAxisIron(1.0, 1.0, 0.0), Eigen::Vector3d(5.0, 5.0, 0.0), 0.2, rng);
+  const MagCalibration c = FitBidirectional(good.samples, good.roll_pitch_rad);
+  EXPECT_TRUE(c.hard_iron_sigma_uT.array().isNaN().all());
+  EXPECT_TRUE(c.correction_sigma.array().isNaN().all());
+  EXPECT_EQ(c.uncalibrated_axis, Eigen::Vector3d::UnitZ());
+}
+
 // ------------------------------------------------------------------------ heading
 
 TEST(Heading, TiltCompensatedIsExactForTheTrueField) {
@@ -446,6 +583,20 @@ std::unique_ptr<MagCalibration> FitReal(const std::string& name, const std::vect
   }
 }
 
+/// The what() of the runtime_error fit() throws ("" when it does not throw).
+template <typename Fit>
+std::string Refusal(Fit fit) {
+  try {
+    fit();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The DOT's straight flight holds one heading (yaw within ~5 deg): the readings are near one
+// plane (normal about sensor -y) and an arc of its circle. Each method refuses with the
+// reason instead of inventing a calibration (docs/calibration-magnetometer.md, real data).
 TEST(RealData, XsensDotRawMagnetometer) {
   const std::string path =
       testing::DataPath("ansfl-quadrotor/StraightLine/RAW/Xsens_DOT1_D422CD003EBC_20220707_111438.csv");
@@ -454,9 +605,17 @@ TEST(RealData, XsensDotRawMagnetometer) {
   const std::vector<MagSample> samples = ReadAll(*reader);
   ASSERT_GT(samples.size(), 1000u);
   const auto c = FitReal("DOT1 111438", samples);
-  if (c) {
-    EXPECT_LT(c->field_spread_after_uT, c->field_spread_before_uT);
-  }
+  EXPECT_FALSE(c);
+  const std::string ellipsoid = Refusal([&] { FitEllipsoid(samples); });
+  EXPECT_NE(ellipsoid.find("all samples near one plane"), std::string::npos) << ellipsoid;
+  const std::string planar = Refusal([&] { FitPlanar(samples); });
+  std::cout << "[real] DOT1 111438 planar: " << planar << "\n";
+  EXPECT_NE(planar.find("cover only"), std::string::npos) << planar;
+  const std::string bidirectional = Refusal([&] {
+    FitBidirectional(samples, std::vector<Eigen::Vector2d>(samples.size(), Eigen::Vector2d::Zero()));
+  });
+  std::cout << "[real] DOT1 111438 bidirectional: " << bidirectional << "\n";
+  EXPECT_NE(bidirectional.find("not the sensor's x/y plane"), std::string::npos) << bidirectional;
 }
 
 TEST(RealData, Px4UlogMagnetometer) {
