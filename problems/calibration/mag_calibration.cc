@@ -210,6 +210,49 @@ std::vector<double> Magnitudes(const std::vector<MagSample>& samples) {
   return out;
 }
 
+/// The M-estimator (sandwich) covariance of a robust least-squares fit with one scalar
+/// residual per sample: Cov = H^-1 G H^-1 N / (N - P), H = sum psi'_i J_i^T J_i,
+/// G = sum (rho'_i r_i)^2 J_i^T J_i, psi' = rho' + 2 s rho'' (s = r^2; the robust second
+/// derivative, clamped at 0). Also counts the samples the loss down-weights below 0.5.
+template <int P>
+class RobustSandwich {
+ public:
+  using Vector = Eigen::Matrix<double, P, 1>;
+  using Matrix = Eigen::Matrix<double, P, P>;
+
+  explicit RobustSandwich(const ceres::LossFunction* loss) : loss_(loss) {}
+
+  void Add(const Vector& j, double r) {
+    double rho[3] = {r * r, 1.0, 0.0};
+    if (loss_ != nullptr) loss_->Evaluate(r * r, rho);
+    if (rho[1] < 0.5) ++downweighted_;
+    H_.template selfadjointView<Eigen::Lower>().rankUpdate(j, std::max(0.0, rho[1] + 2.0 * r * r * rho[2]));
+    G_.template selfadjointView<Eigen::Lower>().rankUpdate(j, (rho[1] * r) * (rho[1] * r));
+    ++count_;
+  }
+
+  /// Throws std::runtime_error (prefixed with `who`) when H is singular.
+  Matrix Covariance(const std::string& who) const {
+    const Matrix H = H_.template selfadjointView<Eigen::Lower>();
+    const Matrix G = G_.template selfadjointView<Eigen::Lower>();
+    const Eigen::LDLT<Matrix> ldlt(H);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
+      throw std::runtime_error(who + ": the parameters are not observable from these samples "
+                               "(information matrix singular)");
+    }
+    const Matrix H_inv = ldlt.solve(Matrix::Identity());
+    return H_inv * G * H_inv * (static_cast<double>(count_) / (count_ - P));
+  }
+  int downweighted() const { return downweighted_; }
+
+ private:
+  const ceres::LossFunction* loss_;
+  Matrix H_ = Matrix::Zero();
+  Matrix G_ = Matrix::Zero();
+  int count_ = 0;
+  int downweighted_ = 0;
+};
+
 }  // namespace
 
 Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector3d& m_uT) {
@@ -313,15 +356,11 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
                              "): a patch of the sphere fitted by a distorted ellipsoid; cover more attitudes");
   }
 
-  // 5. Residuals, robust weights and the M-estimator (sandwich) covariance of (h, A):
-  //    Cov = H^-1 G H^-1 N / (N - 9),  H = sum psi'_i J_i^T J_i,  G = sum (rho'_i r_i)^2 J_i^T J_i,
-  //    psi' = rho' + 2 s rho'' (s = r^2; the robust second derivative, clamped at 0).
-  Matrix9d H = Matrix9d::Zero();
-  Matrix9d G = Matrix9d::Zero();
+  // 5. Residuals, robust weights and the M-estimator (sandwich) covariance of (h, A).
+  RobustSandwich<9> sandwich(loss.get());
   double ss = 0.0;
   std::vector<double> after;
   after.reserve(samples.size());
-  int downweighted = 0;
   const double* parameters[] = {h, a, &B};
   for (std::size_t i = 0; i < samples.size(); ++i) {
     double r = 0.0;
@@ -331,24 +370,11 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
     problem.GetCostFunctionForResidualBlock(blocks[i])->Evaluate(parameters, &r, jacobians);
     Vector9d j;
     j << jh.transpose(), ja.transpose();
-    double rho[3] = {r * r, 1.0, 0.0};
-    if (loss) loss->Evaluate(r * r, rho);
-    if (rho[1] < 0.5) ++downweighted;
-    const double curvature = std::max(0.0, rho[1] + 2.0 * r * r * rho[2]);
-    H.selfadjointView<Eigen::Lower>().rankUpdate(j, curvature);
-    G.selfadjointView<Eigen::Lower>().rankUpdate(j, (rho[1] * r) * (rho[1] * r));
+    sandwich.Add(j, r);
     ss += r * r;
     after.push_back(r + B);
   }
-  H = H.selfadjointView<Eigen::Lower>();
-  G = G.selfadjointView<Eigen::Lower>();
-  const Eigen::LDLT<Matrix9d> ldlt(H);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
-    throw std::runtime_error("FitEllipsoid: the parameters are not observable from these samples "
-                             "(information matrix singular)");
-  }
-  const Matrix9d H_inv = ldlt.solve(Matrix9d::Identity());
-  const Matrix9d covariance = H_inv * G * H_inv * (static_cast<double>(n) / (n - 9));
+  const Matrix9d covariance = sandwich.Covariance("FitEllipsoid");
   const Vector9d sigma = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   if (sigma.head<3>().maxCoeff() > kMaxHardIronSigmaFraction * c.field_uT) {
     throw std::runtime_error("FitEllipsoid: the hard iron is not determined by these samples (sigma " +
@@ -361,7 +387,7 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
   c.field_spread_before_uT = MeanStd(Magnitudes(samples)).second;
   c.field_spread_after_uT = MeanStd(after).second;
   c.samples = n;
-  c.downweighted = downweighted;
+  c.downweighted = sandwich.downweighted();
   c.method = "ellipsoid";
   return c;
 }
@@ -568,9 +594,8 @@ MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitO
   // Sandwich covariance of (c, A2) as in FitEllipsoid: columns h0, h1, a0, a1, a3.
   using Vector5d = Eigen::Matrix<double, 5, 1>;
   using Matrix5d = Eigen::Matrix<double, 5, 5>;
-  Matrix5d H = Matrix5d::Zero(), G = Matrix5d::Zero();
+  RobustSandwich<5> sandwich(loss.get());
   double ss = 0.0;
-  int downweighted = 0;
   std::vector<double> before, after;
   before.reserve(p.size());
   after.reserve(p.size());
@@ -584,24 +609,12 @@ MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitO
     problem.GetCostFunctionForResidualBlock(blocks[i])->Evaluate(parameters, &r, jacobians);
     Vector5d j;
     j << jh(0), jh(1), ja(0), ja(1), ja(3);
-    double rho[3] = {r * r, 1.0, 0.0};
-    if (loss) loss->Evaluate(r * r, rho);
-    if (rho[1] < 0.5) ++downweighted;
-    H.selfadjointView<Eigen::Lower>().rankUpdate(j, std::max(0.0, rho[1] + 2.0 * r * r * rho[2]));
-    G.selfadjointView<Eigen::Lower>().rankUpdate(j, (rho[1] * r) * (rho[1] * r));
+    sandwich.Add(j, r);
     ss += r * r;
     before.push_back((mean_in_plane + p[i]).norm());
     after.push_back(r + B);
   }
-  H = H.selfadjointView<Eigen::Lower>();
-  G = G.selfadjointView<Eigen::Lower>();
-  const Eigen::LDLT<Matrix5d> ldlt(H);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
-    throw std::runtime_error("FitPlanar: the parameters are not observable from these samples "
-                             "(information matrix singular)");
-  }
-  const Matrix5d H_inv = ldlt.solve(Matrix5d::Identity());
-  const Matrix5d covariance = H_inv * G * H_inv * (static_cast<double>(n) / (n - 5));
+  const Matrix5d covariance = sandwich.Covariance("FitPlanar");
   const double centre_sigma = std::sqrt(std::max(covariance(0, 0), covariance(1, 1)));
   if (centre_sigma > kMaxHardIronSigmaFraction * R) {
     throw std::runtime_error("FitPlanar: the in-plane hard iron is not determined by these samples (sigma " +
@@ -630,7 +643,7 @@ MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitO
   c.field_spread_before_uT = MeanStd(before).second;
   c.field_spread_after_uT = MeanStd(after).second;
   c.samples = n;
-  c.downweighted = downweighted;
+  c.downweighted = sandwich.downweighted();
   c.method = "planar";
   c.coverage_deg = coverage_deg;
   c.out_of_plane_rms_uT = out_of_plane_rms_uT;
