@@ -25,9 +25,9 @@
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
 #include "core/io/open.h"
-#include "core/leveling_model.h"
 #include "core/rotation.h"
 #include "problems/calibration/mag_calibration.h"
+#include "problems/calibration/mag_heading.h"
 
 DECLARE_string(format);  // main.cc
 DECLARE_string(mag);     // cmd_navigate.cc
@@ -46,107 +46,12 @@ Command CalibrateMagCommand();
 
 namespace {
 
+using calibration::HeadingErrors;
 using calibration::MagCalibration;
-
-/// Heading is not reported where the x axis is within this angle of the vertical: roll and
-/// heading are not separable there (and an accelerometer cannot give roll).
-constexpr double kMaxHeadingPitch_rad = 80.0 * kDegToRad;
 
 int Usage(const std::string& why) {
   std::cerr << "navtwin calibrate-mag: " << why << "\nusage: " << CalibrateMagCommand().usage << "\n";
   return kExitUsage;
-}
-
-/// Roll, pitch, yaw (rad) at time t from a sorted navigation record (attitude slerped
-/// between the two records around t); nullopt outside the record.
-std::optional<Eigen::Vector3d> TruthEuler(const std::vector<NavState>& nav, double t_s) {
-  if (nav.empty() || t_s < nav.front().t_s || t_s > nav.back().t_s) return std::nullopt;
-  const auto it = std::lower_bound(nav.begin(), nav.end(), t_s, [](const NavState& s, double t) { return s.t_s < t; });
-  if (it->t_s == t_s || it == nav.begin()) return EulerFromQuat(it->q_n_b);
-  const NavState& a = *(it - 1);
-  const double w = (t_s - a.t_s) / (it->t_s - a.t_s);
-  return EulerFromQuat(a.q_n_b.slerp(w, it->q_n_b));
-}
-
-/// Roll and pitch from the mean specific force of the IMU samples whose time lies within
-/// half_window_s of each magnetometer sample (the nearest sample when none does); nullopt
-/// outside the IMU record.
-class AccelLevel {
- public:
-  AccelLevel(std::vector<ImuSample> imu, double half_window_s) : imu_(std::move(imu)), half_(half_window_s) {
-    sum_dv_.push_back(Eigen::Vector3d::Zero());
-    sum_dt_.push_back(0.0);
-    for (const ImuSample& s : imu_) {
-      sum_dv_.push_back(sum_dv_.back() + s.dv_b_mps);
-      sum_dt_.push_back(sum_dt_.back() + s.dt_s);
-    }
-  }
-  std::optional<Eigen::Vector2d> At(double t_s) const {
-    if (imu_.empty() || t_s < imu_.front().t_s - imu_.front().dt_s - half_ || t_s > imu_.back().t_s + half_) {
-      return std::nullopt;
-    }
-    const auto by_time = [](const ImuSample& s, double t) { return s.t_s < t; };
-    std::size_t lo = std::lower_bound(imu_.begin(), imu_.end(), t_s - half_, by_time) - imu_.begin();
-    std::size_t hi = std::lower_bound(imu_.begin(), imu_.end(), t_s + half_, by_time) - imu_.begin();
-    if (hi <= lo) {  // no sample inside the window: the one nearest to t
-      lo = std::min(lo, imu_.size() - 1);
-      hi = lo + 1;
-    }
-    const Eigen::Vector3d f_b_mps2 = (sum_dv_[hi] - sum_dv_[lo]) / (sum_dt_[hi] - sum_dt_[lo]);
-    const leveling::RollPitch level = leveling::LevelFromSpecificForce(f_b_mps2);
-    return Eigen::Vector2d(level.roll_rad, level.pitch_rad);
-  }
-
- private:
-  std::vector<ImuSample> imu_;
-  double half_;
-  std::vector<Eigen::Vector3d> sum_dv_;
-  std::vector<double> sum_dt_;
-};
-
-double MedianInterval(const std::vector<MagSample>& mag) {
-  std::vector<double> dt;
-  for (std::size_t i = 1; i < mag.size(); ++i) dt.push_back(mag[i].t_s - mag[i - 1].t_s);
-  if (dt.empty()) return 0.0;
-  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
-  return dt[dt.size() / 2];
-}
-
-struct HeadingErrors {
-  int samples = 0;
-  double before_deg = NAN;  ///< RMS; NaN (printed n/a, JSON null) without truth
-  double after_deg = NAN;
-};
-
-/// RMS over the samples with truth of the wrapped heading minus the truth yaw, from the raw
-/// and from the calibrated field: tilt-compensated (3-axis) for the ellipsoid and planar fits,
-/// level (x, y only) for the 2-axis bidirectional method. The planar fit leaves the component
-/// along the plane normal raw (vertical field plus that axis' hard iron): its calibrated
-/// heading is taken from the in-plane part only, else a normal a few degrees off z (soft
-/// iron tilts the plane) would leak tens of uT into x and y.
-HeadingErrors HeadingError(const std::vector<MagSample>& mag, const std::vector<std::optional<Eigen::Vector3d>>& truth,
-                           const MagCalibration& c, bool two_axis, double declination_rad) {
-  HeadingErrors e;
-  double sum_before = 0.0, sum_after = 0.0;
-  const auto heading = [&](const Eigen::Vector3d& m, const Eigen::Vector3d& euler) {
-    return two_axis ? calibration::LevelHeading(m, declination_rad)
-                    : calibration::TiltCompensatedHeading(m, euler[0], euler[1], declination_rad);
-  };
-  for (std::size_t i = 0; i < mag.size(); ++i) {
-    if (!truth[i] || std::abs((*truth[i])[1]) > kMaxHeadingPitch_rad) continue;
-    const double before = WrapPi(heading(mag[i].m_b_uT, *truth[i]) - (*truth[i])[2]);
-    Eigen::Vector3d m_c = calibration::ApplyMagCalibration(c, mag[i].m_b_uT);
-    if (c.method == "planar") m_c -= c.uncalibrated_axis * c.uncalibrated_axis.dot(m_c);
-    const double after = WrapPi(heading(m_c, *truth[i]) - (*truth[i])[2]);
-    sum_before += before * before;
-    sum_after += after * after;
-    ++e.samples;
-  }
-  if (e.samples > 0) {
-    e.before_deg = std::sqrt(sum_before / e.samples) * kRadToDeg;
-    e.after_deg = std::sqrt(sum_after / e.samples) * kRadToDeg;
-  }
-  return e;
 }
 
 /// The command as run, for the calibration file's created_by: the flags of this command
@@ -277,13 +182,14 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
     attitude = "truth";
     const std::vector<NavState> nav = ReadAll<NavState>(*OpenNav(FLAGS_truth));
     for (std::size_t i = 0; i < mag.size(); ++i) {
-      truth[i] = TruthEuler(nav, mag[i].t_s);
+      truth[i] = calibration::EulerAt(nav, mag[i].t_s);
       if (truth[i]) roll_pitch[i] = truth[i]->head<2>();
     }
     if (!FLAGS_imu.empty()) std::cerr << "calibrate-mag: --truth gives roll and pitch; --imu is not used\n";
   } else if (!FLAGS_imu.empty()) {
     attitude = "imu accelerometer";
-    const AccelLevel level(ReadAll<ImuSample>(*OpenImu(FLAGS_imu)), 0.5 * MedianInterval(mag));
+    const calibration::AccelerometerLevel level(ReadAll<ImuSample>(*OpenImu(FLAGS_imu)),
+                                                 0.5 * calibration::MedianInterval_s(mag));
     for (std::size_t i = 0; i < mag.size(); ++i) roll_pitch[i] = level.At(mag[i].t_s);
   } else {
     for (auto& rp : roll_pitch) rp = Eigen::Vector2d::Zero();
@@ -319,7 +225,8 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
               << Fixed(MagnitudeSpread(mag), 4) << " uT): " << e.what() << "\n";
     return kExitFailure;
   }
-  const HeadingErrors heading = HeadingError(mag, truth, c, two_axis, FLAGS_declination_deg * kDegToRad);
+  const calibration::HeadingErrors heading =
+      calibration::MagHeadingErrors(mag, truth, c, two_axis, FLAGS_declination_deg * kDegToRad);
   if (!FLAGS_truth.empty() && heading.samples == 0) {
     std::cerr << "calibrate-mag: warning: no magnetometer sample inside " << FLAGS_truth
               << " (with |pitch| <= 80 deg): heading errors are n/a\n";

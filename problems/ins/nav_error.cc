@@ -62,4 +62,14 @@ NavState InterpolateNav(const NavState& a, const NavState& b, double t_s) {
   return s;
 }
 
+std::optional<NavState> NavAt(const std::vector<NavState>& nav, double t_s, double tolerance_s) {
+  if (nav.empty() || !(t_s >= nav.front().t_s - tolerance_s) || !(t_s <= nav.back().t_s + tolerance_s)) {
+    return std::nullopt;
+  }
+  const auto hi = std::lower_bound(nav.begin(), nav.end(), t_s, [](const NavState& s, double t) { return s.t_s < t; });
+  if (hi == nav.end()) return nav.back();
+  if (hi == nav.begin() || hi->t_s == t_s) return *hi;
+  return InterpolateNav(*(hi - 1), *hi, t_s);
+}
+
 }  // namespace navtwin

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -47,5 +49,10 @@ class NavErrorStats {
 /// Linear interpolation of position and velocity, spherical of attitude, between two
 /// states at t in [a.t_s, b.t_s].
 NavState InterpolateNav(const NavState& a, const NavState& b, double t_s);
+
+/// The state of a time-sorted record at t (InterpolateNav between the records around t);
+/// nullopt outside [front.t_s - tolerance_s, back.t_s + tolerance_s] (the end record within
+/// the tolerance).
+std::optional<NavState> NavAt(const std::vector<NavState>& nav, double t_s, double tolerance_s = 0.0);
 
 }  // namespace navtwin

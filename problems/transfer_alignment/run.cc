@@ -21,6 +21,7 @@
 
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
+#include "problems/ins/nav_error.h"
 
 namespace navtwin::transfer {
 namespace {
@@ -33,15 +34,9 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 /// R_n_b of the truth at t (slerp between the records around t); empty outside its span.
 std::optional<Eigen::Quaterniond> TruthAttitudeAt(const std::vector<NavState>& truth, double t_s) {
-  if (truth.empty() || !(t_s >= truth.front().t_s - 1e-9) || !(t_s <= truth.back().t_s + 1e-9)) return std::nullopt;
-  const auto hi = std::lower_bound(truth.begin(), truth.end(), t_s,
-                                   [](const NavState& s, double t) { return s.t_s < t; });
-  if (hi == truth.end()) return truth.back().q_n_b;
-  if (hi == truth.begin() || std::abs(hi->t_s - t_s) < 1e-9) return hi->q_n_b;
-  const NavState& a = *(hi - 1);
-  const NavState& b = *hi;
-  const double w = (t_s - a.t_s) / (b.t_s - a.t_s);
-  return a.q_n_b.slerp(w, b.q_n_b).normalized();  // Eigen's slerp takes the short way
+  const std::optional<NavState> s = NavAt(truth, t_s, 1e-9);
+  if (!s) return std::nullopt;
+  return s->q_n_b.normalized();  // Eigen's slerp takes the short way
 }
 
 Eigen::Vector3d EulerOf(const Eigen::Quaterniond& q) { return EulerFromDcm(Eigen::Matrix3d(q.toRotationMatrix())); }
