@@ -210,6 +210,21 @@ std::vector<double> Magnitudes(const std::vector<MagSample>& samples) {
   return out;
 }
 
+/// Dense, single-threaded, silent solve of a small fit; throws std::runtime_error (prefixed
+/// with `who`) when Ceres gives no usable solution.
+void Solve(int max_iterations, const std::string& who, ceres::Problem* problem) {
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = max_iterations;
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, problem, &summary);
+  if (!summary.IsSolutionUsable()) {
+    throw std::runtime_error(who + ": the least-squares solve failed: " + summary.message);
+  }
+}
+
 /// The M-estimator (sandwich) covariance of a robust least-squares fit with one scalar
 /// residual per sample: Cov = H^-1 G H^-1 N / (N - P), H = sum psi'_i J_i^T J_i,
 /// G = sum (rho'_i r_i)^2 J_i^T J_i, psi' = rho' + 2 s rho'' (s = r^2; the robust second
@@ -332,16 +347,7 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
     blocks.push_back(problem.AddResidualBlock(MagEllipsoid::Create(s.m_b_uT, 1.0), loss.get(), h, a, &B));
   }
   problem.SetParameterBlockConstant(&B);
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  if (!summary.IsSolutionUsable()) {
-    throw std::runtime_error("FitEllipsoid: the least-squares solve failed: " + summary.message);
-  }
+  Solve(options.max_iterations, "FitEllipsoid", &problem);
   c.hard_iron_uT = Eigen::Vector3d(h[0], h[1], h[2]);
   c.correction = MagEllipsoid::SymmetricFromUpper(a);
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig_a(c.correction);
@@ -551,16 +557,7 @@ MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitO
   problem.SetManifold(h, new ceres::SubsetManifold(3, {2}));
   problem.SetManifold(a, new ceres::SubsetManifold(6, {2, 4, 5}));
   problem.SetParameterBlockConstant(&B);
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.num_threads = 1;
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
-  if (!summary.IsSolutionUsable()) {
-    throw std::runtime_error("FitPlanar: the least-squares solve failed: " + summary.message);
-  }
+  Solve(options.max_iterations, "FitPlanar", &problem);
   const Eigen::Vector2d centre(h[0], h[1]);
   Eigen::Matrix2d A2;
   A2 << a[0], a[1], a[1], a[3];

@@ -50,6 +50,32 @@ std::string Num(double v, int precision = 4) {
 /// Indices of the triad parameters that depend on temperature: scale factors and biases.
 bool IsTemperatureDependent(int triad_index) { return triad_index < 3 || triad_index >= 9; }
 
+/// Temperature terms of the given order, all coefficients 0.
+TemperatureTerms ZeroTerms(double reference_degC, int order) {
+  TemperatureTerms terms;
+  terms.reference_degC = reference_degC;
+  const std::vector<Eigen::Vector3d> zero(static_cast<std::size_t>(order), Eigen::Vector3d::Zero());
+  terms.gyro_bias_rad_per_s = terms.gyro_scale_factor = terms.accel_bias_mps2 = terms.accel_scale_factor = zero;
+  return terms;
+}
+
+/// Stores coefficient k (1..order) of triad parameter `triad_index` (a scale factor 0..2 or
+/// a bias 9..11, IsTemperatureDependent) in its place among the terms.
+void SetTemperatureCoefficient(bool gyro, int triad_index, int k, double coefficient, TemperatureTerms* terms) {
+  const bool scale = triad_index < 3;
+  const int axis = scale ? triad_index : triad_index - 9;
+  std::vector<Eigen::Vector3d>& column =
+      gyro ? (scale ? terms->gyro_scale_factor : terms->gyro_bias_rad_per_s)
+           : (scale ? terms->accel_scale_factor : terms->accel_bias_mps2);
+  column[static_cast<std::size_t>(k - 1)](axis) = coefficient;
+}
+
+/// One sigma per parameter, NaN (not estimated) until set.
+template <int N>
+Eigen::Matrix<double, N, 1> NotEstimated() {
+  return Eigen::Matrix<double, N, 1>::Constant(std::numeric_limits<double>::quiet_NaN());
+}
+
 /// Where a run's estimate of one parameter lives: its index in the run's covariance.
 struct RunTerm {
   int run = 0;
@@ -225,19 +251,10 @@ TemperatureCalibration CalibrateTemperature(const std::vector<TemperatureRun>& r
   std::vector<LinearOutput> outputs;
   ImuCalibrationResult& result = out.result;
   ImuCalibration& cal = result.calibration;
-  Eigen::Matrix<double, kTriadParameters, 1> gyro_sigma, accel_sigma;
-  Eigen::Matrix<double, kGSensitivityParameters, 1> g_sigma;
-  gyro_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
-  accel_sigma = gyro_sigma;
-  g_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
-  TemperatureTerms terms;
-  terms.reference_degC = reference_degC;
-  for (int k = 1; k <= options.order; ++k) {
-    terms.gyro_bias_rad_per_s.push_back(Eigen::Vector3d::Zero());
-    terms.gyro_scale_factor.push_back(Eigen::Vector3d::Zero());
-    terms.accel_bias_mps2.push_back(Eigen::Vector3d::Zero());
-    terms.accel_scale_factor.push_back(Eigen::Vector3d::Zero());
-  }
+  Eigen::Matrix<double, kTriadParameters, 1> gyro_sigma = NotEstimated<kTriadParameters>();
+  Eigen::Matrix<double, kTriadParameters, 1> accel_sigma = NotEstimated<kTriadParameters>();
+  Eigen::Matrix<double, kGSensitivityParameters, 1> g_sigma = NotEstimated<kGSensitivityParameters>();
+  TemperatureTerms terms = ZeroTerms(reference_degC, options.order);
 
   struct Parameter {
     std::string triad;  ///< "gyro", "accel" or "g_sensitivity"
@@ -314,14 +331,8 @@ TemperatureCalibration CalibrateTemperature(const std::vector<TemperatureRun>& r
       accel_sigma(p.index) = s0;
     }
     if (temperature_dependent) {
-      const int axis = p.index < 3 ? p.index : p.index - 9;
       for (int k = 1; k <= order; ++k) {
-        const double c = fit.fit.coefficients(k);
-        if (p.triad == "gyro") {
-          (p.index < 3 ? terms.gyro_scale_factor : terms.gyro_bias_rad_per_s)[k - 1](axis) = c;
-        } else {
-          (p.index < 3 ? terms.accel_scale_factor : terms.accel_bias_mps2)[k - 1](axis) = c;
-        }
+        SetTemperatureCoefficient(p.triad == "gyro", p.index, k, fit.fit.coefficients(k), &terms);
       }
       if (fit.fit.dof > 0) {
         result.notes.push_back(name + ": order-" + std::to_string(order) + " fit chi-square " +
@@ -634,19 +645,10 @@ WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const Temp
 
   ImuCalibrationResult& result = out.result;
   ImuCalibration& cal = result.calibration;
-  Eigen::Matrix<double, kTriadParameters, 1> gyro_sigma, accel_sigma;
-  Eigen::Matrix<double, kGSensitivityParameters, 1> g_sigma;
-  gyro_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
-  accel_sigma = gyro_sigma;
-  g_sigma.setConstant(std::numeric_limits<double>::quiet_NaN());
-  TemperatureTerms terms;
-  terms.reference_degC = reference_degC;
-  for (int k = 1; k <= order; ++k) {
-    terms.gyro_bias_rad_per_s.push_back(Eigen::Vector3d::Zero());
-    terms.gyro_scale_factor.push_back(Eigen::Vector3d::Zero());
-    terms.accel_bias_mps2.push_back(Eigen::Vector3d::Zero());
-    terms.accel_scale_factor.push_back(Eigen::Vector3d::Zero());
-  }
+  Eigen::Matrix<double, kTriadParameters, 1> gyro_sigma = NotEstimated<kTriadParameters>();
+  Eigen::Matrix<double, kTriadParameters, 1> accel_sigma = NotEstimated<kTriadParameters>();
+  Eigen::Matrix<double, kGSensitivityParameters, 1> g_sigma = NotEstimated<kGSensitivityParameters>();
+  TemperatureTerms terms = ZeroTerms(reference_degC, order);
   // Outputs in the chamber path's order: gyro block, accel block, g-sensitivity; each
   // temperature-dependent parameter followed by its .dT<k>.
   std::vector<std::pair<int, int>> where;
@@ -670,15 +672,9 @@ WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const Temp
       (gyro ? cal.gyro : cal.accel)(idx) = fits[f].x(j);
       (gyro ? gyro_sigma : accel_sigma)(idx) = std::sqrt(fits[f].covariance(j, j));
       if (!IsTemperatureDependent(idx)) continue;
-      const int axis = idx < 3 ? idx : idx - 9;
       for (int k = 1; k <= order; ++k) {
         if (!add(name + ".dT" + std::to_string(k))) continue;
-        const double c = fits[where.back().first].x(where.back().second);
-        if (gyro) {
-          (idx < 3 ? terms.gyro_scale_factor : terms.gyro_bias_rad_per_s)[k - 1](axis) = c;
-        } else {
-          (idx < 3 ? terms.accel_scale_factor : terms.accel_bias_mps2)[k - 1](axis) = c;
-        }
+        SetTemperatureCoefficient(gyro, idx, k, fits[where.back().first].x(where.back().second), &terms);
       }
     }
   }

@@ -532,11 +532,11 @@ class TemperatureRecord : public ::testing::Test {
   std::string dir_;
 };
 
-/// The schedule of kSixPositionsDeg in the simulator's YAML schema.
-std::string TrajectoryYaml(double dwell_s) {
+/// A record's table schedule in the simulator's YAML schema.
+std::string ScheduleYaml(const std::vector<Eigen::Vector3d>& euler_deg, double dwell_s) {
   std::string y = "{kind: multiposition, rotation_s: 2, dwell_s: " + std::to_string(dwell_s) + ", steps: [";
-  for (std::size_t i = 0; i < kSixPositionsDeg.size(); ++i) {
-    const Eigen::Vector3d& e = kSixPositionsDeg[i];
+  for (std::size_t i = 0; i < euler_deg.size(); ++i) {
+    const Eigen::Vector3d& e = euler_deg[i];
     y += std::string(i ? ", " : "") + "{euler_deg: [" + std::to_string(e.x()) + ", " + std::to_string(e.y()) + ", " +
          std::to_string(e.z()) + "]}";
   }
@@ -555,7 +555,7 @@ TEST_F(TemperatureRecord, FileGivesTheInMemoryResult) {
     for (const ImuSample& s : runs[i].data.imu) writer.Write(s);
     writer.Commit();
     record += "  - {temperature_degC: " + std::to_string(temperatures[i]) + ", imu: " + name +
-              ", trajectory: " + TrajectoryYaml(dwell_s) + "}\n";
+              ", trajectory: " + ScheduleYaml(kSixPositionsDeg, dwell_s) + "}\n";
   }
   const std::string path = Write("chamber.yaml", record);
   const ImuCalibrationResult from_file = CalibrateTemperatureRecord(path);
@@ -818,17 +818,6 @@ TEST_F(TemperatureRecord, TemperatureFileErrorsNameFileLineAndField) {
   ASSERT_EQ(ok.t_s.size(), 2u);
   EXPECT_EQ(ok.t_s[1], 0.1);
   EXPECT_EQ(ok.temperature_degC[1], 20.5);
-}
-
-/// A record's table schedule in the simulator's YAML schema.
-std::string ScheduleYaml(const std::vector<Eigen::Vector3d>& euler_deg, double dwell_s) {
-  std::string y = "{kind: multiposition, rotation_s: 2, dwell_s: " + std::to_string(dwell_s) + ", steps: [";
-  for (std::size_t i = 0; i < euler_deg.size(); ++i) {
-    const Eigen::Vector3d& e = euler_deg[i];
-    y += std::string(i ? ", " : "") + "{euler_deg: [" + std::to_string(e.x()) + ", " + std::to_string(e.y()) + ", " +
-         std::to_string(e.z()) + "]}";
-  }
-  return y + "]}";
 }
 
 // The whole path through files: `navtwin simulate` of a warm-up on the table writes
