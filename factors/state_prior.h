@@ -4,6 +4,8 @@
 //   radii at p0). Block pos {lat_rad, lon_rad, h_m} (3, PositionManifold).
 // VectorPrior3:  r = (x - x0) / sigma                          (3 residuals)
 //   Block x (3, Euclidean): velocity, a bias, scale factors.
+// ScalarPrior:   r = (x - x0) / sigma                          (1 residual)
+//   Block x (1): an installation or sensor parameter (e.g. an odometer scale factor).
 // sigma per axis (Vector3d) or one for all axes (double); each > 0 and finite.
 #pragma once
 
@@ -89,6 +91,32 @@ class VectorPrior3 {
  private:
   Eigen::Vector3d x0_;
   Eigen::Vector3d inv_sigma_;
+};
+
+class ScalarPrior {
+ public:
+  static constexpr int kResiduals = 1;
+  static constexpr int kValueSize = 1;  ///< block 0: x
+
+  ScalarPrior(double x0, double std) : x0_(x0), inv_sigma_(1.0 / std) {
+    if (!(std > 0.0) || !std::isfinite(std)) throw std::invalid_argument("ScalarPrior: std must be positive and finite");
+    if (!std::isfinite(x0)) throw std::invalid_argument("ScalarPrior: x0 must be finite");
+  }
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    residual[0] = (x[0] - T(x0_)) * T(inv_sigma_);
+    return true;
+  }
+
+  /// 1 residual; block x (1).
+  static ceres::CostFunction* Create(double x0, double std) {
+    return new ceres::AutoDiffCostFunction<ScalarPrior, kResiduals, kValueSize>(new ScalarPrior(x0, std));
+  }
+
+ private:
+  double x0_;
+  double inv_sigma_;
 };
 
 }  // namespace navtwin

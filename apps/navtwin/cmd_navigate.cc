@@ -30,8 +30,7 @@
 #include "core/sim/presets.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
-// ins_state.h before config.h, which uses InsState.
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/gnss_ins/ins_vocabulary.h"
 #include "problems/gnss_ins/config.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/densify.h"
@@ -62,6 +61,10 @@ DEFINE_double(outage_start_s, NAN, "Injected GNSS outages for scoring: first out
 DEFINE_double(outage_len_s, 0.0, "Injected GNSS outages: length of each, s");
 DEFINE_double(outage_period_s, 0.0, "Injected GNSS outages: period, s (0: a single outage)");
 DEFINE_string(demo_scenario, "mems-gps-mag-maneuver", "smooth --demo: the simulated scenario (a preset name or a scenario YAML)");
+DEFINE_bool(nhc, false, "Ground vehicles: the non-holonomic constraint (no lateral or vertical velocity of the vehicle reference point), on top of --config or --kfgins_config");
+DEFINE_double(nhc_sigma_mps, NAN, "Sigma of the non-holonomic constraint, m/s (default: the configuration's nhc.std_mps, 0.1)");
+DEFINE_string(vehicle_mounting_rpy_deg, "", "Roll,pitch,yaw of the IMU (body) axes in the vehicle frame, deg, e.g. 0,0,1.5 (default: the configuration's vehicle.mounting_rpy_deg)");
+DEFINE_string(vehicle_lever_arm_b_m, "", "x,y,z of the vehicle reference point (where NHC holds and the odometer measures) from the IMU, body axes, m (default: the configuration's vehicle.lever_arm_b_m)");
 DEFINE_string(demo_mag, "vector", "smooth --demo: magnetometer use, off|vector|heading|heading_2axis");
 
 namespace navtwin::app {
@@ -81,6 +84,43 @@ int Usage(const std::string& command, const std::string& why, const std::string&
 bool IsDir(const std::string& dir) {
   struct stat st;
   return ::stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/// "x,y,z" as three finite numbers (false when it is not).
+bool ParseTriple(const std::string& text, Eigen::Vector3d* out) {
+  std::istringstream in(text);
+  for (int i = 0; i < 3; ++i) {
+    std::string field;
+    if (!std::getline(in, field, ',')) return false;
+    std::istringstream number(field);
+    double v = 0.0;
+    if (!(number >> v) || !(number >> std::ws).eof() || !std::isfinite(v)) return false;
+    (*out)[i] = v;
+  }
+  std::string rest;
+  return !std::getline(in, rest);
+}
+
+/// The vehicle-constraint flags applied on top of the configuration; an error text for a
+/// bad value (empty: fine).
+std::string ApplyVehicleFlags(GnssInsConfig* config) {
+  if (FLAGS_nhc) config->nhc.enabled = true;
+  if (!std::isnan(FLAGS_nhc_sigma_mps)) {
+    if (!(FLAGS_nhc_sigma_mps > 0.0) || !std::isfinite(FLAGS_nhc_sigma_mps)) return "--nhc_sigma_mps must be > 0";
+    config->nhc.std_mps = FLAGS_nhc_sigma_mps;
+  }
+  if (!FLAGS_vehicle_mounting_rpy_deg.empty()) {
+    Eigen::Vector3d rpy_deg;
+    if (!ParseTriple(FLAGS_vehicle_mounting_rpy_deg, &rpy_deg)) {
+      return "--vehicle_mounting_rpy_deg must be three numbers roll,pitch,yaw";
+    }
+    config->vehicle.mounting_rpy_rad = rpy_deg * (M_PI / 180.0);
+  }
+  if (!FLAGS_vehicle_lever_arm_b_m.empty() &&
+      !ParseTriple(FLAGS_vehicle_lever_arm_b_m, &config->vehicle.lever_arm_b_m)) {
+    return "--vehicle_lever_arm_b_m must be three numbers x,y,z";
+  }
+  return "";
 }
 
 /// Whether a flag was given a value other than its default (compared as text: is_default
@@ -414,6 +454,7 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
     config.outages.len_s = FLAGS_outage_len_s;
     config.outages.period_s = FLAGS_outage_period_s;
   }
+  if (const std::string why = ApplyVehicleFlags(&config); !why.empty()) return usage(why);
   ctx.files = files;
 
   if (!folder) folder = std::make_unique<OutputFolder>(files.out);
@@ -507,11 +548,13 @@ const char* const kNavigateUsage =
     "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
+    "[--nhc [--nhc_sigma_mps S]] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
+    "[--nhc [--nhc_sigma_mps S]] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--format=json]\n"
     "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
 
@@ -526,7 +569,8 @@ Command NavigateCommand() {
           kNavigateUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "smoother", "truth",
            "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
-           "calibration", "imu_temperature_degC"},
+           "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps", "vehicle_mounting_rpy_deg",
+           "vehicle_lever_arm_b_m"},
           &RunNavigate};
 }
 
@@ -536,7 +580,8 @@ Command SmoothCommand() {
           kSmoothUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "truth", "output_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
-           "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC"},
+           "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps",
+           "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m"},
           &RunSmooth};
 }
 

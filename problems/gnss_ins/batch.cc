@@ -27,50 +27,50 @@
 #include "core/strapdown.h"
 #include "factors/attitude_manifold.h"
 #include "factors/attitude_prior.h"
-#include "factors/baro_height.h"
 #include "factors/bias_process.h"
-#include "factors/gnss_position.h"
-#include "factors/gnss_velocity.h"
 #include "factors/imu_preintegration.h"
-#include "factors/mag_heading.h"
-#include "factors/mag_vector.h"
 #include "factors/position_manifold.h"
 #include "factors/state_prior.h"
-#include "factors/zero_velocity.h"
-#include "problems/gnss_ins/filter.h"  // InitialStdVector, InitialFilterState, CalibrateMag,
-                                        // MeasurementSigma, StillnessDetector (the filter's rules)
+#include "problems/gnss_ins/initial_state.h"
+#include "problems/gnss_ins/sources.h"
+#include "problems/ins/measurement_rules.h"
 #include "solvers/batch_driver.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
-/// Two times closer than this are the same epoch (as in the filter).
-constexpr double kTimeEps_s = 1e-6;
+constexpr double kTimeEps_s = ins::kSameEpoch_s;
 
-const char* const kGnssPos = "gnss_position";
-const char* const kGnssVel = "gnss_velocity";
-const char* const kMag = "mag";
-const char* const kBaro = "baro";
-const char* const kZupt = "zupt";
+using ins::AidingSource;
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
 
-/// A state epoch and, when it is a GNSS epoch, the index of its GNSS sample (-1 if none).
+/// A state epoch and, when the anchoring source placed it, the index of its sample (-1 if none).
 struct PlannedState {
   double t_s;
-  long gnss;
+  long anchor;
 };
 
 struct Plan {
   std::vector<PlannedState> states;
-  std::size_t gnss_thinned = 0;  ///< GNSS epochs in the span left out by state_interval_s
-  std::size_t gnss_velocity_thinned = 0;  ///< of these, the ones with velocity
+  std::vector<std::size_t> thinned;  ///< anchor samples in the span left out by state_interval_s
 };
 
-Plan PlanStates(const Inputs& inputs, const GnssInsConfig& config, double t0_s, double t_end_s) {
+/// The sample times of the source that anchors the states (at most one; none: empty).
+std::vector<double> AnchorTimes(const ins::AidingSources& sources) {
+  const AidingSource* anchoring = nullptr;
+  for (const auto& source : sources) {
+    if (!source->anchors_batch_states()) continue;
+    if (anchoring != nullptr) throw std::invalid_argument("RunBatch: two aiding sources anchor the states");
+    anchoring = source.get();
+  }
+  return anchoring != nullptr ? anchoring->times() : std::vector<double>();
+}
+
+Plan PlanStates(const std::vector<double>& anchor_times, const GnssInsConfig& config, double t0_s, double t_end_s) {
   const double max_gap = config.batch.max_state_interval_s;
   if (!(max_gap > 0.0) || !std::isfinite(max_gap)) {
     throw std::invalid_argument("RunBatch: batch.max_state_interval_s must be positive and finite");
@@ -78,17 +78,16 @@ Plan PlanStates(const Inputs& inputs, const GnssInsConfig& config, double t0_s, 
   const double thin = config.batch.state_interval_s;
   Plan plan;
   std::vector<PlannedState> anchors{{t0_s, -1}};
-  for (std::size_t i = 0; i < inputs.gnss.size(); ++i) {
-    const double t = inputs.gnss[i].t_s;
+  for (std::size_t i = 0; i < anchor_times.size(); ++i) {
+    const double t = anchor_times[i];
     if (t < t0_s - kTimeEps_s) continue;
     if (t > t_end_s + kTimeEps_s) break;
     if (t <= t0_s + kTimeEps_s) {  // at the first state
-      anchors.front().gnss = static_cast<long>(i);
+      anchors.front().anchor = static_cast<long>(i);
       continue;
     }
     if (thin > 0.0 && t - anchors.back().t_s < thin - kTimeEps_s) {
-      ++plan.gnss_thinned;
-      plan.gnss_velocity_thinned += inputs.gnss[i].has_velocity ? 1 : 0;
+      plan.thinned.push_back(i);
       continue;
     }
     anchors.push_back({t, static_cast<long>(i)});
@@ -107,7 +106,7 @@ Plan PlanStates(const Inputs& inputs, const GnssInsConfig& config, double t0_s, 
 /// The parameter blocks and the initial information of one state.
 struct BatchState {
   double t_s = 0.0;
-  long gnss = -1;
+  long anchor = -1;
   std::array<double, 3> pos{};  ///< lat_rad, lon_rad, h_m
   std::array<double, 3> vel{};  ///< v_n_mps
   std::array<double, 4> q{};    ///< q_n_b x, y, z, w
@@ -119,46 +118,6 @@ struct BatchState {
   Eigen::Vector3d omega_ib_b_radps = Eigen::Vector3d::Zero();  ///< bias-corrected, at t_s
   bool still = false;           ///< the stillness rule holds at t_s
 };
-
-/// R_{b(a) b(b)} for a <= b: the body rotation over [a, b] as the product of Exp of the
-/// bias-corrected gyro increments (pieces of samples pro rata), v_{b(a)} = R v_{b(b)}. The
-/// rotation of the navigation frame over |b - a| <= kMaxSensorAssociation_s (< 4e-5 rad)
-/// is left out.
-Eigen::Quaterniond BodyRotation(const std::vector<ImuSample>& imu, double a, double b, const ImuErrors& e) {
-  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-  auto it = std::upper_bound(imu.begin(), imu.end(), a + kTimeEps_s,
-                             [](double t, const ImuSample& s) { return t < s.t_s; });
-  for (; it != imu.end() && it->t_s - it->dt_s < b - kTimeEps_s; ++it) {
-    const double lo = std::max(it->t_s - it->dt_s, a);
-    const double hi = std::min(it->t_s, b);
-    if (hi <= lo) continue;
-    const ImuSample c = CorrectImu(*it, e);
-    q = q * QuatFromRotVec<double>(c.dtheta_b_rad * ((hi - lo) / it->dt_s));
-  }
-  return q.normalized();
-}
-
-/// For every state, the index of the sample nearest in time among those whose nearest
-/// state it is (each sample used at most once), within kMaxSensorAssociation_s; -1 if none.
-template <typename Sample>
-std::vector<long> AssociateNearest(const std::vector<Sample>& samples, const std::vector<BatchState>& states) {
-  std::vector<long> best(states.size(), -1);
-  std::vector<double> best_dt(states.size(), std::numeric_limits<double>::infinity());
-  std::vector<double> times(states.size());
-  for (std::size_t i = 0; i < states.size(); ++i) times[i] = states[i].t_s;
-  for (std::size_t k = 0; k < samples.size(); ++k) {
-    const double t = samples[k].t_s;
-    const auto it = std::lower_bound(times.begin(), times.end(), t);
-    std::size_t j = static_cast<std::size_t>(it - times.begin());
-    if (j == times.size() || (j > 0 && t - times[j - 1] < times[j] - t)) --j;
-    const double dt = std::abs(t - times[j]);
-    if (dt <= kMaxSensorAssociation_s && dt < best_dt[j]) {
-      best_dt[j] = dt;
-      best[j] = static_cast<long>(k);
-    }
-  }
-  return best;
-}
 
 /// How a bias (gyro or accelerometer) is modelled.
 struct BiasModel {
@@ -179,24 +138,38 @@ BiasModel MakeBiasModel(double steady_std, double tau_s, const Eigen::Vector3d& 
   return m;
 }
 
-class BatchSmoother {
+class BatchSmoother : public ins::BatchAccess {
  public:
   BatchSmoother(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, std::ostream* progress)
-      : in_(inputs), cfg_(config), start_(start), progress_(progress) {}
+      : in_(inputs), cfg_(config), start_(start), progress_(progress), sources_(MakeSources(inputs, config)) {}
 
   Solution Run();
+
+  // ins::BatchAccess
+  std::size_t num_states() const override { return views_.size(); }
+  const State& state(std::size_t i) const override { return views_[i]; }
+  const std::vector<ImuSample>& imu() const override { return in_.imu; }
+  const std::vector<std::size_t>& thinned_anchors() const override { return thinned_; }
+  double* aux(int i) override { return &aux_[static_cast<std::size_t>(aux_begin_[current_] + i)]; }
+  void Add(ceres::CostFunction* cost, bool robust, const std::vector<double*>& blocks,
+           const std::string& key) override {
+    problem_->AddResidualBlock(cost, robust ? huber_.get() : nullptr, blocks);
+    ++counts_[key].used;
+  }
+  void Count(const std::string& key, bool used) override {
+    MeasurementCount& c = counts_[key];
+    ++(used ? c.used : c.rejected);
+  }
 
  private:
   void Check() const;
   void Initialise(const Plan& plan);
   void MechanizeAndPreintegrate();
+  void MakeViews();
   void BuildProblem();
   void AddImuFactor(std::size_t i);
-  void AddGnss();
-  void AddMag();
-  void AddBaro();
-  void AddZupt();
   void AddPriors();
+  void AddAuxPriors();
   int Reintegrate();
   void Covariance(Solution* solution, std::ostringstream* report);
   void Say(const std::string& line) const {
@@ -207,6 +180,14 @@ class BatchSmoother {
   const GnssInsConfig& cfg_;
   const Solution& start_;
   std::ostream* progress_;
+
+  ins::AidingSources sources_;
+  std::vector<State> views_;             ///< the states as the sources see them
+  std::vector<std::size_t> thinned_;
+  std::vector<double> aux_;              ///< the sources' auxiliary parameter blocks (1 each)
+  std::vector<ins::AuxState> aux_states_;
+  std::vector<int> aux_begin_;           ///< per source: its first auxiliary block
+  std::size_t current_ = 0;              ///< the source adding its residuals
 
   BiasModel gyro_model_, accel_model_;
   std::array<double, 3> shared_bg_{}, shared_ba_{};
@@ -244,9 +225,6 @@ void BatchSmoother::Check() const {
   if (!(n.gyro_arw_rad_per_sqrt_s > 0.0) || !(n.accel_vrw_mps_per_sqrt_s > 0.0)) {
     throw std::invalid_argument("RunBatch: the IMU preintegration needs a positive gyro ARW and accelerometer VRW");
   }
-  if (cfg_.mag.mode == MagConfig::Mode::kVector && cfg_.mag.field_ned_uT.isZero(0.0)) {
-    throw std::invalid_argument("RunBatch: magnetometer mode vector needs mag.field_ned_uT");
-  }
 }
 
 void BatchSmoother::Initialise(const Plan& plan) {
@@ -257,13 +235,34 @@ void BatchSmoother::Initialise(const Plan& plan) {
   states_.resize(plan.states.size());
   for (std::size_t i = 0; i < states_.size(); ++i) {
     states_[i].t_s = plan.states[i].t_s;
-    states_[i].gnss = plan.states[i].gnss;
+    states_[i].anchor = plan.states[i].anchor;
     states_[i].bg_block = gyro_model_.shared ? shared_bg_.data() : states_[i].bg.data();
     states_[i].ba_block = accel_model_.shared ? shared_ba_.data() : states_[i].ba.data();
   }
-  for (const char* key : {kGnssPos, kGnssVel, kMag, kBaro, kZupt}) counts_[key];
-  counts_[kGnssPos].rejected += plan.gnss_thinned;
-  if (cfg_.gnss.use_velocity) counts_[kGnssVel].rejected += plan.gnss_velocity_thinned;
+  thinned_ = plan.thinned;
+  for (const auto& source : sources_) {
+    for (const std::string& key : source->keys()) counts_[key];
+    aux_begin_.push_back(static_cast<int>(aux_states_.size()));
+    for (const ins::AuxState& a : source->aux_states()) aux_states_.push_back(a);
+  }
+  aux_.resize(aux_states_.size());
+  for (std::size_t i = 0; i < aux_.size(); ++i) aux_[i] = aux_states_[i].initial;
+}
+
+void BatchSmoother::MakeViews() {
+  views_.resize(states_.size());
+  for (std::size_t i = 0; i < states_.size(); ++i) {
+    BatchState& s = states_[i];
+    State& v = views_[i];
+    v.t_s = s.t_s;
+    v.pos = s.pos.data();
+    v.vel = s.vel.data();
+    v.q = s.q.data();
+    v.initial = &s.initial;
+    v.omega_ib_b_radps = s.omega_ib_b_radps;
+    v.still = s.still;
+    v.anchor = s.anchor;
+  }
 }
 
 /// One pass over the IMU record: the strapdown mechanization from the latest knot of the
@@ -282,7 +281,9 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   ImuErrors errors = knots.front().state.imu;
   std::size_t kn = 1, si = 0;
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();
-  StillnessDetector detector(cfg_.zupt);
+  const ins::ZuptConfig* still_rule = ins::StillnessRule(sources_);
+  std::optional<ins::StillnessDetector> detector;
+  if (still_rule != nullptr) detector.emplace(*still_rule);
   ImuErrors scale;  // the scale factors of the current interval (biases zero)
 
   // The bias blocks' initial values: each state's from its knot, shared ones from the first.
@@ -292,7 +293,7 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     s.initial.nav.t_s = s.t_s;
     s.initial.imu = errors;
     s.omega_ib_b_radps = omega;
-    s.still = cfg_.zupt.enabled && detector.Still();
+    s.still = detector && detector->Still();
     const NavState& nav = s.initial.nav;
     s.pos = {nav.lat_rad, nav.lon_rad, nav.h_m};
     s.vel = {nav.v_n_mps.x(), nav.v_n_mps.y(), nav.v_n_mps.z()};
@@ -344,7 +345,7 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   if (k != imu.end()) omega = CorrectImu(*k, errors).dtheta_b_rad / k->dt_s;
   // Samples ending at or before t0 only feed the stillness window.
   for (auto w = imu.begin(); w != imu.end() && w->t_s <= t0 + kTimeEps_s; ++w) {
-    if (cfg_.zupt.enabled && w->t_s > t0 - cfg_.zupt.window_s - 1.0) detector.Add(CorrectImu(*w, errors));
+    if (detector && w->t_s > t0 - still_rule->window_s - 1.0) detector->Add(CorrectImu(*w, errors));
   }
   record_state();
   k = std::upper_bound(imu.begin(), imu.end(), t0 + kTimeEps_s,
@@ -366,7 +367,7 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     }
     if (si >= n) break;
     step(piece);
-    if (cfg_.zupt.enabled) detector.Add(CorrectImu(*k, errors));
+    if (detector) detector->Add(CorrectImu(*k, errors));
     events(piece.t_s);
   }
   if (si < n) {
@@ -383,145 +384,6 @@ void BatchSmoother::AddImuFactor(std::size_t i) {
   imu_factors_[i] = problem_->AddResidualBlock(CreateImuFactor(pre_[i]), nullptr,
                                                {a.pos.data(), a.vel.data(), a.q.data(), a.bg_block, a.ba_block,
                                                 b.pos.data(), b.vel.data(), b.q.data()});
-}
-
-void BatchSmoother::AddGnss() {
-  const Eigen::Vector3d& lever = cfg_.installation.antenna_lever_arm_b_m;
-  for (BatchState& s : states_) {
-    if (s.gnss < 0) continue;
-    const GnssSample& g = in_.gnss[static_cast<std::size_t>(s.gnss)];
-    const Eigen::Vector3d sp = MeasurementSigma(g.pos_std_ned_m, cfg_.gnss.pos_std_floor_m, cfg_.gnss.default_pos_std_m);
-    problem_->AddResidualBlock(GnssPosition::Create(Eigen::Vector3d(g.lat_rad, g.lon_rad, g.h_m), lever, sp),
-                               huber_.get(), s.pos.data(), s.q.data());
-    ++counts_[kGnssPos].used;
-    if (cfg_.gnss.use_velocity && g.has_velocity) {
-      const Eigen::Vector3d sv =
-          MeasurementSigma(g.vel_std_ned_mps, cfg_.gnss.vel_std_floor_mps, cfg_.gnss.default_vel_std_mps);
-      problem_->AddResidualBlock(GnssVelocity::Create(g.v_n_mps, lever, s.omega_ib_b_radps, sv), huber_.get(),
-                                 s.vel.data(), s.q.data());
-      ++counts_[kGnssVel].used;
-    }
-  }
-}
-
-void BatchSmoother::AddMag() {
-  const MagConfig& mc = cfg_.mag;
-  if (mc.mode == MagConfig::Mode::kOff || in_.mag.empty()) return;
-  const std::vector<long> nearest = AssociateNearest(in_.mag, states_);
-  // The calibrated samples rotated into the body axes at their states' epochs.
-  std::vector<std::pair<std::size_t, Eigen::Vector3d>> samples;
-  double last_used_s = -INFINITY;
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    if (nearest[i] < 0) continue;
-    const BatchState& s = states_[i];
-    const MagSample& sample = in_.mag[static_cast<std::size_t>(nearest[i])];
-    if (sample.t_s - last_used_s < mc.min_interval_s - kTimeEps_s) continue;
-    // The calibrated field in the body axes at the state epoch.
-    const Eigen::Vector3d m_sample = CalibrateMag(sample.m_b_uT, mc);
-    Eigen::Vector3d m = m_sample;
-    if (sample.t_s > s.t_s) {
-      m = BodyRotation(in_.imu, s.t_s, sample.t_s, s.initial.imu) * m_sample;
-    } else if (sample.t_s < s.t_s) {
-      m = BodyRotation(in_.imu, sample.t_s, s.t_s, s.initial.imu).conjugate() * m_sample;
-    }
-    if (!m.allFinite()) {
-      ++counts_[kMag].rejected;
-      continue;
-    }
-    samples.emplace_back(i, m);
-    last_used_s = sample.t_s;
-  }
-  // kHeading: the reference field (MagHeading's H0 and dip direction) is the mean of the
-  // samples rotated into NED with the initial attitudes (the filter's rule, with
-  // the whole record; docs/gnss-ins.md, "Magnetometer modes").
-  Eigen::Vector3d field_sum_uT = Eigen::Vector3d::Zero();
-  for (const auto& [i, m] : samples) field_sum_uT += states_[i].initial.nav.q_n_b * m;
-  const Eigen::Vector3d mean_field_uT = field_sum_uT / std::max<std::size_t>(samples.size(), 1);
-  for (const auto& [i, m] : samples) {
-    BatchState& s = states_[i];
-    ceres::CostFunction* cost = nullptr;
-    switch (mc.mode) {
-      case MagConfig::Mode::kVector:
-        cost = MagVector::Create(m, mc.field_ned_uT, mc.noise_uT);
-        break;
-      case MagConfig::Mode::kHeading: {
-        const double h0_uT = mean_field_uT.head<2>().norm();
-        if (!(h0_uT > 0.0)) {
-          ++counts_[kMag].rejected;  // a vertical mean field: no heading
-          continue;
-        }
-        cost = MagHeading::Create(MagHeading::RemoveDipNoise(m, s.initial.nav.q_n_b, mean_field_uT),
-                                  mc.declination_rad, mc.heading_std_rad, h0_uT);
-        break;
-      }
-      case MagConfig::Mode::kHeading2Axis: {
-        const Eigen::Vector3d rpy = EulerFromQuat<double>(s.initial.nav.q_n_b);
-        if (!(std::abs(rpy[0]) < mc.max_tilt_rad && std::abs(rpy[1]) < mc.max_tilt_rad)) {
-          ++counts_[kMag].rejected;  // tilted: the 2-axis compass is not used
-          continue;
-        }
-        cost = MagHeading2Axis::Create(m.x(), m.y(), mc.declination_rad, mc.heading_std_rad);
-        break;
-      }
-      case MagConfig::Mode::kOff:
-        return;
-    }
-    problem_->AddResidualBlock(cost, nullptr, s.q.data());
-    ++counts_[kMag].used;
-  }
-}
-
-void BatchSmoother::AddBaro() {
-  if (!cfg_.baro.use || in_.baro.empty()) return;
-  // The offset altitude - height, at the first usable sample at or after the first GNSS
-  // epoch of the states (or the first state without GNSS), with the initial height
-  // interpolated between the states around it.
-  double from_s = states_.front().t_s;
-  for (const BatchState& s : states_) {
-    if (s.gnss >= 0) {
-      from_s = s.t_s;
-      break;
-    }
-  }
-  std::optional<double> offset_m;
-  double offset_t_s = 0.0;
-  for (const BaroSample& b : in_.baro) {
-    if (b.t_s < from_s - kTimeEps_s || !std::isfinite(b.altitude_m)) continue;
-    if (b.t_s > states_.back().t_s + kTimeEps_s) break;
-    auto it = std::upper_bound(states_.begin(), states_.end(), b.t_s,
-                               [](double t, const BatchState& s) { return t < s.t_s; });
-    const BatchState& hi = it == states_.end() ? states_.back() : *it;
-    const BatchState& lo = it == states_.begin() ? states_.front() : *(it - 1);
-    const double span = hi.t_s - lo.t_s;
-    const double a = span > 0.0 ? (b.t_s - lo.t_s) / span : 0.0;
-    const double h = (1.0 - a) * lo.initial.nav.h_m + a * hi.initial.nav.h_m;
-    offset_m = b.altitude_m - h;
-    offset_t_s = b.t_s;
-    break;
-  }
-  const std::vector<long> nearest = AssociateNearest(in_.baro, states_);
-  for (std::size_t i = 0; i < states_.size(); ++i) {
-    if (nearest[i] < 0) continue;
-    BatchState& s = states_[i];
-    const BaroSample& b = in_.baro[static_cast<std::size_t>(nearest[i])];
-    if (!offset_m || b.t_s < offset_t_s - kTimeEps_s || !std::isfinite(b.altitude_m)) {
-      ++counts_[kBaro].rejected;
-      continue;
-    }
-    // Carried to the state time with the initial vertical velocity: dh/dt = -v_d.
-    const double h_m = b.altitude_m - *offset_m - s.initial.nav.v_n_mps.z() * (s.t_s - b.t_s);
-    problem_->AddResidualBlock(BaroHeight::Create(h_m, cfg_.baro.std_m), nullptr, s.pos.data());
-    ++counts_[kBaro].used;
-  }
-}
-
-void BatchSmoother::AddZupt() {
-  if (!cfg_.zupt.enabled) return;
-  for (BatchState& s : states_) {
-    if (!s.still) continue;
-    problem_->AddResidualBlock(ZeroVelocity::Create(cfg_.zupt.std_mps), nullptr, s.vel.data());
-    ++counts_[kZupt].used;
-  }
 }
 
 void BatchSmoother::AddPriors() {
@@ -585,11 +447,26 @@ void BatchSmoother::BuildProblem() {
                                  states_[i].ba_block, states_[i + 1].ba_block);
     }
   }
-  AddGnss();
-  AddMag();
-  AddBaro();
-  AddZupt();
+  for (std::size_t i = 0; i < sources_.size(); ++i) {
+    current_ = i;
+    sources_[i]->AddToBatch(*this);
+  }
   AddPriors();
+  AddAuxPriors();
+}
+
+/// The sources' auxiliary parameters: priors (held constant with a zero initial std).
+void BatchSmoother::AddAuxPriors() {
+  for (std::size_t i = 0; i < aux_.size(); ++i) {
+    double* block = &aux_[i];
+    if (!problem_->HasParameterBlock(block)) problem_->AddParameterBlock(block, 1);
+    if (aux_states_[i].initial_std > 0.0) {
+      problem_->AddResidualBlock(ScalarPrior::Create(aux_states_[i].initial, aux_states_[i].initial_std), nullptr,
+                                 block);
+    } else {
+      problem_->SetParameterBlockConstant(block);
+    }
+  }
 }
 
 /// Reintegrates the intervals whose gyro bias moved too far from the linearisation point
@@ -624,6 +501,9 @@ void BatchSmoother::Covariance(Solution* solution, std::ostringstream* report) {
       if (seen.insert(b).second) blocks.push_back(b);
     }
   }
+  for (const double& a : aux_) {
+    if (!problem_->IsParameterBlockConstant(&a)) blocks.push_back(&a);
+  }
   BlockCovarianceOptions options;
   options.num_threads = std::max(1, cfg_.batch.threads);
   const BlockCovarianceResult result = ComputeBlockDiagonalCovariance(*problem_, blocks, options);
@@ -643,6 +523,12 @@ void BatchSmoother::Covariance(Solution* solution, std::ostringstream* report) {
     std.segment<3>(err::kAtt) = stds[s.q.data()];
     std.segment<3>(err::kBg) = stds[s.bg_block];
     std.segment<3>(err::kBa) = stds[s.ba_block];
+    Eigen::VectorXd& aux_std = solution->epochs[i].aux_std;
+    aux_std = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(aux_.size()));
+    for (std::size_t k = 0; k < aux_.size(); ++k) {
+      const auto it = stds.find(&aux_[k]);
+      if (it != stds.end()) aux_std[static_cast<Eigen::Index>(k)] = it->second[0];
+    }
   }
   std::ostringstream line;
   line.precision(3);
@@ -656,17 +542,17 @@ Solution BatchSmoother::Run() {
   const auto wall_start = std::chrono::steady_clock::now();
   Check();
   const double t0 = start_.epochs.front().state.nav.t_s;
-  const Plan plan = PlanStates(in_, cfg_, t0, in_.imu.back().t_s);
+  const Plan plan = PlanStates(AnchorTimes(sources_), cfg_, t0, in_.imu.back().t_s);
   Initialise(plan);
   MechanizeAndPreintegrate();
+  MakeViews();
   BuildProblem();
   {
     std::ostringstream line;
     line.precision(3);
-    line << states_.size() << " states, " << imu_samples_ << " IMU pieces preintegrated, "
-         << counts_[kGnssPos].used << " GNSS positions, " << counts_[kGnssVel].used << " velocities, "
-         << counts_[kMag].used << " mag, " << counts_[kBaro].used << " baro, " << counts_[kZupt].used
-         << " ZUPT; setup " << Seconds(wall_start) << " s";
+    line << states_.size() << " states, " << imu_samples_ << " IMU pieces preintegrated";
+    for (const auto& [key, count] : counts_) line << ", " << count.used << " " << key;
+    line << "; setup " << Seconds(wall_start) << " s";
     Say(line.str());
   }
 
@@ -707,6 +593,7 @@ Solution BatchSmoother::Run() {
     x.imu = s.initial.imu;  // scale factors as used
     x.imu.bg_radps = Eigen::Map<const Eigen::Vector3d>(s.bg_block);
     x.imu.ba_mps2 = Eigen::Map<const Eigen::Vector3d>(s.ba_block);
+    solution.epochs[i].aux = Eigen::Map<const Eigen::VectorXd>(aux_.data(), static_cast<Eigen::Index>(aux_.size()));
   }
   if (cfg_.batch.covariance) Covariance(&solution, &report);
   solution.counts = counts_;
@@ -725,7 +612,7 @@ Solution BatchSmoother::Run() {
 }  // namespace
 
 std::vector<double> BatchStateTimes(const Inputs& inputs, const GnssInsConfig& config, double t0_s, double t_end_s) {
-  const Plan plan = PlanStates(inputs, config, t0_s, t_end_s);
+  const Plan plan = PlanStates(AnchorTimes(MakeSources(inputs, config)), config, t0_s, t_end_s);
   std::vector<double> times;
   times.reserve(plan.states.size());
   for (const PlannedState& s : plan.states) times.push_back(s.t_s);

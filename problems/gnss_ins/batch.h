@@ -21,20 +21,10 @@
 //    state i; samples split at the state times (core/imu_split.h) and corrected for the
 //    start solution's scale factors (the batch estimates none);
 //  - BiasGaussMarkov between consecutive bias blocks (ImuNoise stds, correlation time);
-//  - GNSS position and velocity at their states (lever arm; sigma as the filter's:
-//    max(file sigma, floor) or the default; velocity with the bias-corrected angular rate of
-//    the IMU sample at the epoch), Huber loss with threshold config.batch.huber_k sigmas
-//    on each whitened 3-vector (0: none);
-//  - magnetometer (config.mag.mode): for each state the sample nearest in time (within
-//    kMaxSensorAssociation_s; each sample used at most once, at most one per
-//    mag.min_interval_s), calibrated (CalibrateMag) and rotated into the body axes at the
-//    state epoch with the bias-corrected gyro increments between the two times; the 2-axis
-//    heading only where the start solution's |roll| and |pitch| are below max_tilt_rad;
-//  - barometer (config.baro.use): the sample nearest each state (same association),
-//    carried to the state time with the initial vertical velocity, offset = altitude -
-//    initial height at the first usable sample at or after the first GNSS epoch;
-//  - ZUPT (config.zupt.enabled): at the states where the filter's stillness rule holds over
-//    the last window_s of IMU samples;
+//  - the aiding sources' residuals (gnss_ins/sources.h; problems/ins/sources/*.h say each
+//    one's rule: GNSS at its states with the Huber loss of config.batch.huber_k sigmas,
+//    magnetometer and barometer samples carried to their nearest states, ZUPT at the still
+//    states, NHC at the moving ones) and priors on the sources' auxiliary parameters;
 //  - priors on the first state from config.init.std (InitialStdVector), centred on the
 //    filter's initial state when it starts at the same time, else on the first knot.
 // Solved with sparse normal Cholesky (SuiteSparse, solvers/batch_driver.h). Where a
@@ -50,17 +40,12 @@
 #include <ostream>
 #include <vector>
 
-// ins_state.h first: config.h uses InsState without including it.
-#include "problems/gnss_ins/ins_state.h"
-// (keep this order)
 #include "problems/gnss_ins/config.h"
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/solution.h"
 
 namespace navtwin::gnss_ins {
 
-/// Magnetometer and barometer samples farther than this from every state are not used.
-constexpr double kMaxSensorAssociation_s = 0.5;
 /// Reintegrate-and-solve rounds after the first solve, at most.
 constexpr int kMaxReintegrationRounds = 3;
 

@@ -1,8 +1,7 @@
 // The two configuration loaders of config.h: navtwin's YAML (keys with units in their
 // names, docs/gnss-ins.md "Configuration") and KF-GINS' YAML taken unchanged
 // (docs/gnss-ins.md "KF-GINS mapping").
-// ins_state.h first: config.h uses InsState without including it (reported to the lead).
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/gnss_ins/ins_vocabulary.h"
 #include "problems/gnss_ins/config.h"
 
 #include <algorithm>
@@ -343,6 +342,23 @@ ZuptConfig ParseZupt(const ConfigNode& n) {
   return x;
 }
 
+NhcConfig ParseNhc(const ConfigNode& n) {
+  n.RequireKeys({"use", "std_mps", "interval_s"});
+  NhcConfig x;
+  x.enabled = n.Bool("use", x.enabled);
+  x.std_mps = Sigma(n, "std_mps", x.std_mps);
+  x.interval_s = NonNegative(n, "interval_s", x.interval_s);
+  return x;
+}
+
+VehicleConfig ParseVehicle(const ConfigNode& n) {
+  n.RequireKeys({"mounting_rpy_deg", "lever_arm_b_m"});
+  VehicleConfig x;
+  x.mounting_rpy_rad = n.Vector("mounting_rpy_deg", Eigen::Vector3d::Zero()) * kDegToRad;
+  x.lever_arm_b_m = n.Vector("lever_arm_b_m", Eigen::Vector3d::Zero());
+  return x;
+}
+
 GnssConfig ParseGnss(const ConfigNode& n) {
   n.RequireKeys({"use_velocity", "pos_std_floor_m", "vel_std_floor_mps", "default_pos_std_m",
                  "default_vel_std_mps", "max_distance_m"});
@@ -468,8 +484,8 @@ void CrossCheckRate(const std::string& config_path, long line, const std::string
 
 GnssInsConfig LoadGnssInsConfig(const std::string& path) {
   const ConfigNode root = sim::LoadYamlFile(path);
-  root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "gnss", "outages",
-                    "filter", "batch", "output_rate_hz", "start_s", "end_s"});
+  root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "nhc", "vehicle", "gnss",
+                    "outages", "filter", "batch", "output_rate_hz", "start_s", "end_s"});
   if (!root.Has("imu_noise")) root.Fail("imu_noise", "required");
   GnssInsConfig c;
   c.start_time_s = root.Double("start_s", c.start_time_s);
@@ -486,6 +502,8 @@ GnssInsConfig LoadGnssInsConfig(const std::string& path) {
   }
   c.baro = ParseBaro(root.Child("baro"));
   c.zupt = ParseZupt(root.Child("zupt"));
+  c.nhc = ParseNhc(root.Child("nhc"));
+  c.vehicle = ParseVehicle(root.Child("vehicle"));
   c.gnss = ParseGnss(root.Child("gnss"));
   c.outages = ParseOutages(root.Child("outages"));
   c.batch = ParseBatch(root.Child("batch"));

@@ -10,22 +10,10 @@
 #include <Eigen/Core>
 
 #include "core/types.h"
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/gnss_ins/ins_vocabulary.h"
 
 namespace navtwin::gnss_ins {
 
-/// IMU noise and error-process parameters. Biases and scale factors are first-order
-/// Gauss-Markov processes with steady-state standard deviation *_std and correlation time
-/// correlation_time_s (infinite: random constants driven by no noise).
-struct ImuNoise {
-  double gyro_arw_rad_per_sqrt_s = 0.0;
-  double accel_vrw_mps_per_sqrt_s = 0.0;
-  double gyro_bias_std_radps = 0.0;
-  double accel_bias_std_mps2 = 0.0;
-  double gyro_scale_std = 0.0;   ///< dimensionless (ppm * 1e-6)
-  double accel_scale_std = 0.0;
-  double correlation_time_s = 3600.0;
-};
 
 /// 1-sigma uncertainty of the initial state (error-state layout of ins_state.h).
 struct InitialStd {
@@ -78,51 +66,6 @@ struct InitConfig {
   InitialStd std;
 };
 
-/// Magnetometer use. Calibration (hard iron h, soft iron S) follows the simulator's model
-/// m_b = (I + S) R_b_n m_n + h; measurements are corrected as (I + S)^-1 (m - h).
-struct MagConfig {
-  enum class Mode {
-    kOff,
-    kVector,        ///< full field vector in the body axes (needs field_ned_uT)
-    kHeading,       ///< 3-axis tilt-compensated heading
-    kHeading2Axis,  ///< seed 001: heading from x, y only, used while |roll|, |pitch| < max_tilt_rad
-  };
-  Mode mode = Mode::kOff;
-  Eigen::Vector3d field_ned_uT = Eigen::Vector3d::Zero();  ///< for kVector
-  double declination_rad = 0.0;                            ///< east of true north
-  Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d soft_iron = Eigen::Matrix3d::Zero();
-  double noise_uT = 0.5;            ///< per axis, kVector
-  double heading_std_rad = 0.035;   ///< kHeading, kHeading2Axis
-  double max_tilt_rad = 2.0 * 3.14159265358979323846 / 180.0;
-  double min_interval_s = 0.0;      ///< use at most one sample per this interval (0: all)
-};
-
-struct BaroConfig {
-  bool use = false;
-  double std_m = 1.0;
-  /// The barometer's offset from the ellipsoidal height is taken at the first GNSS epoch
-  /// (or the initial state) and held constant.
-};
-
-struct ZuptConfig {
-  bool enabled = false;
-  double std_mps = 0.02;
-  double window_s = 0.5;                 ///< detection window
-  double gyro_threshold_radps = 0.01;    ///< max |omega| over the window
-  double accel_std_threshold_mps2 = 0.05;///< max std of |f| over the window
-  double interval_s = 0.1;               ///< at most one update per this interval
-};
-
-struct GnssConfig {
-  bool use_velocity = true;        ///< when the file has velocity
-  double pos_std_floor_m = 0.0;    ///< sigma used = max(file sigma, floor)
-  double vel_std_floor_mps = 0.0;
-  double default_pos_std_m = 5.0;  ///< when the file gives none
-  double default_vel_std_mps = 0.1;
-  double max_distance_m = 10000.0; ///< a fix this far from the INS prediction is an input error
-};
-
 /// Injected GNSS outages for scoring: no GNSS in [start + k period, start + k period + len).
 struct OutageConfig {
   double start_s = std::numeric_limits<double>::quiet_NaN();  ///< NaN: none (relative to the
@@ -161,6 +104,8 @@ struct GnssInsConfig {
   MagConfig mag;
   BaroConfig baro;
   ZuptConfig zupt;
+  NhcConfig nhc;
+  VehicleConfig vehicle;
   GnssConfig gnss;
   OutageConfig outages;
   FilterConfig filter;

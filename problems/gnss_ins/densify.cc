@@ -20,6 +20,8 @@ NavEpoch Blend(const NavEpoch& a, const NavEpoch& b, double w) {
   e.state.imu.sg = (1.0 - w) * a.state.imu.sg + w * b.state.imu.sg;
   e.state.imu.sa = (1.0 - w) * a.state.imu.sa + w * b.state.imu.sa;
   if (a.std.size() == b.std.size()) e.std = (1.0 - w) * a.std + w * b.std;
+  if (a.aux.size() == b.aux.size()) e.aux = (1.0 - w) * a.aux + w * b.aux;
+  if (a.aux_std.size() == b.aux_std.size()) e.aux_std = (1.0 - w) * a.aux_std + w * b.aux_std;
   return e;
 }
 

@@ -8,7 +8,7 @@
 //  - the covariance is propagated over groups of samples at most
 //    FilterConfig::covariance_interval_s long: Phi, Qd from the error dynamics at the
 //    group's last sample with the group's mean corrected f_b and omega_ib_b
-//    (problems/gnss_ins/error_dynamics.h);
+//    (problems/ins/error_dynamics.h);
 //  - a GNSS epoch between two IMU time tags splits the IMU sample there (core/imu_split.h):
 //    nominal state and covariance are propagated to exactly the GNSS time, updated, and the
 //    rest of the sample follows with the corrected IMU errors. Magnetometer and barometer
@@ -23,7 +23,6 @@
 //    the sum of the corrections fed back there. The RTS smoother runs over these knots.
 #pragma once
 
-#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
@@ -34,12 +33,12 @@
 
 #include <Eigen/Core>
 
-// ins_state.h first: config.h uses InsState without including it.
-#include "problems/gnss_ins/ins_state.h"
-// (keep this order)
 #include "problems/gnss_ins/config.h"
+#include "problems/gnss_ins/initial_state.h"
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/solution.h"
+#include "problems/ins/aiding.h"
+#include "problems/gnss_ins/ins_vocabulary.h"
 
 namespace navtwin::gnss_ins {
 
@@ -97,75 +96,10 @@ FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, bool r
                        const std::function<void(const NavEpoch&)>& output, std::ostream* progress,
                        bool keep_covariances = false);
 
-/// The initial error-state standard deviations (n = 15 or 21) from config.init.std, where
-/// a zero bias / scale-factor entry is replaced by the ImuNoise value (*_std), and with a
-/// heading search (static alignment, kSearch) the heading's (phi_D) is the search's,
-/// HeadingSearchYawStd (heading_search.h).
-Eigen::VectorXd InitialStdVector(const GnssInsConfig& config, int n);
-
-/// Where the filter starts (problems/gnss_ins/filter_support.cc).
-struct FilterStart {
-  InsState state;  ///< the initial nominal state at state.nav.t_s
-  /// Whether measurements tagged exactly at the start time are used (kGiven), or were
-  /// used to make the state (alignment, GNSS velocity) and are skipped.
-  bool use_measurements_at_start = true;
-};
-
-/// The initial state per config.init.source (see RunFilter); a heading search reports on
-/// `progress` when not null (it is deterministic: every call picks the same heading).
-/// Throws InputError when the inputs hold no data to initialise from (no IMU samples; no
-/// GNSS fix for the alignment's position; no magnetometer sample for its heading; no GNSS
-/// epoch after it for a heading search; no fast enough GNSS velocity; IMU data not
-/// static), std::invalid_argument for kGiven without a state or a magnetometer heading
-/// with mag.mode off.
-FilterStart InitialFilterState(const Inputs& inputs, const GnssInsConfig& config,
-                               std::ostream* progress = nullptr);
-
-/// Covariance propagation over one covariance group: P <- Phi P Phi^T + Qd with Phi and Qd
-/// as DiscreteErrorDynamics (error_dynamics.h) defines them, Phi = I + F dt + (F dt)^2 / 2,
-/// Qd = (Phi G Qc G^T Phi^T + G Qc G^T) dt / 2, F, G, Qc from ErrorDynamicsF/G/Qc at x, but
-/// computed in fixed-size blocks that use the model's structure: with the error state split
-/// into navigation (pos, vel, att: 9) and IMU errors (6 or 12), F = [[Fnn, Fns], [0, Fss]]
-/// (IMU errors are driven by themselves only) and G Qc G^T = blockdiag(Qn, Qs) (white
-/// sensor noise into the navigation rows, the bias driving noise into the IMU-error rows;
-/// G's IMU-error block is I). About 10 times faster than the dense 15 x 15 products; the
-/// tests check it against DiscreteErrorDynamics and ErrorStateKalmanFilter::Predict. When
-/// phi_acc is not null, *phi_acc <- Phi * phi_acc (phi_acc must be block upper triangular
-/// in the same split, as every product of such transitions is). n = P->rows() (15 or 21).
-void PropagateCovariance(const InsState& x, const Eigen::Vector3d& f_b_mps2,
-                         const Eigen::Vector3d& omega_ib_b_radps, const ImuNoise& noise, double dt_s,
-                         Eigen::MatrixXd* P, Eigen::MatrixXd* phi_acc);
-
-/// sigma = max(file sigma, floor) per axis, or max(fallback, floor) where the file gives
-/// none (NaN): the GNSS sigmas the filter uses.
-Eigen::Vector3d MeasurementSigma(const Eigen::Vector3d& file_sigma, double floor, double fallback);
-
-/// ZUPT detection: the vehicle is still when, over the last window_s of IMU samples
-/// (bias-corrected, body axes), every |omega| = |dtheta| / dt stays at or below
-/// gyro_threshold_radps and the standard deviation of |f| = |dv| / dt stays at or below
-/// accel_std_threshold_mps2. Samples are added in time order.
-class StillnessDetector {
- public:
-  explicit StillnessDetector(const ZuptConfig& config) : config_(config) {}
-  void Add(const ImuSample& s);
-  /// Whether the samples cover the whole window and satisfy both thresholds.
-  bool Still() const;
-
- private:
-  struct Entry {
-    double begin_s;   ///< start of the sample's interval
-    double f_mps2;    ///< |f| - 9.8 (offset so that the sums of squares do not cancel)
-    bool moving;      ///< |omega| above the threshold
-  };
-  ZuptConfig config_;
-  std::deque<Entry> window_;
-  int moving_ = 0;
-  double sum_ = 0.0, sum_sq_ = 0.0;
-  bool full_ = false;
-};
-
-/// A magnetometer sample with the hard- and soft-iron calibration removed:
-/// (I + S)^-1 (m - h) (config.h, MagConfig).
-Eigen::Vector3d CalibrateMag(const Eigen::Vector3d& m_raw_uT, const MagConfig& mag);
+/// The filter from a given start (InitialFilterState, run before it): the same as above
+/// without the alignment step.
+FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, const FilterStart& start,
+                       bool run_rts, const std::function<void(const NavEpoch&)>& output,
+                       std::ostream* progress, bool keep_covariances = false);
 
 }  // namespace navtwin::gnss_ins

@@ -25,8 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "problems/gnss_ins/ins_state.h"
-// (ins_state.h before config.h)
+#include "problems/gnss_ins/ins_vocabulary.h"
 #include "problems/gnss_ins/config.h"
 #include "problems/gnss_ins/inputs.h"
 

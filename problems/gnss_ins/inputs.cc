@@ -1,7 +1,6 @@
 // LoadInputs (inputs.h): reads the IMU, GNSS, magnetometer and barometer records, applies
 // the installation, cuts to the configured time span, bridges short IMU gaps, injects the
 // scoring outages and checks what the estimators rely on (docs/gnss-ins.md "Bad input").
-#include "problems/gnss_ins/ins_state.h"  // before inputs.h: config.h uses InsState
 #include "problems/gnss_ins/inputs.h"
 
 #include <algorithm>

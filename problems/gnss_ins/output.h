@@ -22,7 +22,7 @@
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/gnss_ins/ins_vocabulary.h"
 
 namespace navtwin::gnss_ins {
 

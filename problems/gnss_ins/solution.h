@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/gnss_ins/ins_vocabulary.h"
 
 namespace navtwin::gnss_ins {
 

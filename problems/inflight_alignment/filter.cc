@@ -14,8 +14,8 @@
 #include "core/earth.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
-#include "problems/gnss_ins/error_dynamics.h"
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/ins/error_dynamics.h"
+#include "problems/ins/ins_state.h"
 #include "problems/inflight_alignment/gps_smoother.h"
 #include "problems/inflight_alignment/inputs.h"
 
@@ -37,12 +37,12 @@ constexpr double kPerSqrtHour = 1.0 / 60.0;  // 1/sqrt(h) = 1/(60 sqrt(s))
 constexpr double kBlock_s = 0.1;
 constexpr double kTimeEpsilon_s = 1e-6;
 
-// The filter's states in the 15-state layout of problems/gnss_ins/ins_state.h (err::):
+// The filter's states in the 15-state layout of problems/ins/ins_state.h (err::):
 // dp_N, dp_E, dv_N, dv_E, phi_N, phi_E, phi_D, dbg_x, dbg_y, dba_x, dba_y.
 constexpr std::array<int, kFilterStates> kIn15 = {
-    gnss_ins::err::kPos + 0, gnss_ins::err::kPos + 1, gnss_ins::err::kVel + 0, gnss_ins::err::kVel + 1,
-    gnss_ins::err::kAtt + 0, gnss_ins::err::kAtt + 1, gnss_ins::err::kAtt + 2, gnss_ins::err::kBg + 0,
-    gnss_ins::err::kBg + 1,  gnss_ins::err::kBa + 0,  gnss_ins::err::kBa + 1};
+    ins::err::kPos + 0, ins::err::kPos + 1, ins::err::kVel + 0, ins::err::kVel + 1,
+    ins::err::kAtt + 0, ins::err::kAtt + 1, ins::err::kAtt + 2, ins::err::kBg + 0,
+    ins::err::kBg + 1,  ins::err::kBa + 0,  ins::err::kBa + 1};
 static_assert(fstate::kPos == 0 && fstate::kVel == 2 && fstate::kLevel == 4 && fstate::kHeading == 6 &&
                   fstate::kBg == 7 && fstate::kBa == 9,
               "kIn15 follows the fstate layout");
@@ -139,14 +139,14 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
   run.method = method;
 
   // ---- nominal state: the INS (raw IMU corrected by the bias estimates) and the estimates
-  gnss_ins::InsState ins;  // nav + estimated IMU errors (body x, y biases; z and scale factors 0)
+  ins::InsState ins;  // nav + estimated IMU errors (body x, y biases; z and scale factors 0)
   ins.nav = initial;
   Strapdown strapdown(initial);
 
   // ---- process noise: white noise only; the biases are random constants whose
   // uncertainty is the specification in the initial P (no driving noise, infinite
   // correlation time).
-  gnss_ins::ImuNoise noise;
+  ins::ImuNoise noise;
   noise.gyro_arw_rad_per_sqrt_s = config.sensors.gyro_arw_deg_sqrt_h * kDegToRad * kPerSqrtHour;
   noise.accel_vrw_mps_per_sqrt_s = config.sensors.accel_vrw_m_s_sqrt_h * kPerSqrtHour;
   noise.gyro_bias_std_radps = 0.0;
@@ -194,8 +194,8 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
     if (block_dt_s <= 0.0) return;
     ins.nav = strapdown.state();
     // Mean bias-corrected specific force and rate over the block, the INS state at its end.
-    gnss_ins::DiscreteErrorDynamics(ins, block_dv_mps / block_dt_s, block_dtheta_rad / block_dt_s, noise,
-                                    gnss_ins::err::kSize15, block_dt_s, &Phi15, &Qd15);
+    ins::DiscreteErrorDynamics(ins, block_dv_mps / block_dt_s, block_dtheta_rad / block_dt_s, noise,
+                                    ins::err::kSize15, block_dt_s, &Phi15, &Qd15);
     // The filter's rows and columns: the vertical channel (held by the baro loop) and the
     // z biases (unobservable in level flight, negligible over minutes) are left out.
     const Matrix11 Phi = Sub(Phi15);
@@ -213,7 +213,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
 
   auto step = [&](const ImuSample& raw) {
     const double baro_m = BaroAltitudeAt(inputs.baro, raw.t_s);
-    const ImuSample corrected = gnss_ins::CorrectImu(raw, ins.imu);
+    const ImuSample corrected = ins::CorrectImu(raw, ins.imu);
     const double h_before_m = strapdown.state().h_m;
     strapdown.Update(corrected);
     NavState nav = strapdown.state();
@@ -238,7 +238,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
   // Feeds a 15-state correction (true minus estimate) into the INS and the bias estimates.
   auto feed_back = [&](const Eigen::VectorXd& dx15) {
     ins.nav = strapdown.state();
-    ins = gnss_ins::ApplyCorrection(ins, dx15);
+    ins = ins::ApplyCorrection(ins, dx15);
     strapdown.SetState(ins.nav);
   };
 
@@ -314,7 +314,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
       P = A * P * A.transpose() + K * R * K.transpose();
       P = 0.5 * (P + P.transpose()).eval();
 
-      Eigen::VectorXd dx15 = Eigen::VectorXd::Zero(gnss_ins::err::kSize15);  // vertical, z biases: 0
+      Eigen::VectorXd dx15 = Eigen::VectorXd::Zero(ins::err::kSize15);  // vertical, z biases: 0
       for (int i = 0; i < kFilterStates; ++i) dx15(kIn15[i]) = dx(i);
       feed_back(dx15);  // the error state is zero again
       epoch.innovation_ne_m = z;
@@ -342,8 +342,8 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
             hc.separation = sep;
             // yaw -= correction: attitude error phi = (0, 0, -correction), since a
             // rotation phi_D about down adds phi_D to the yaw (distance_heading.h).
-            Eigen::VectorXd dphi = Eigen::VectorXd::Zero(gnss_ins::err::kSize15);
-            dphi(gnss_ins::err::kAtt + 2) = -hc.correction_rad;
+            Eigen::VectorXd dphi = Eigen::VectorXd::Zero(ins::err::kSize15);
+            dphi(ins::err::kAtt + 2) = -hc.correction_rad;
             feed_back(dphi);
             heading_applied_rad = sep.dh_rad;
             // A new, independent heading estimate.

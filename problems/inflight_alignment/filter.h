@@ -1,11 +1,11 @@
 // The seed's in-flight alignment filter (seed 003, figure 2) and the conventional
 // Kalman-only baseline, one class with one model.
 //
-// Error state (true minus estimate, the layout of problems/gnss_ins/ins_state.h restricted
+// Error state (true minus estimate, the layout of problems/ins/ins_state.h restricted
 // to the horizontal channel), 11 components:
 //   [0,2) dp_NE_m   [2,4) dv_NE_mps   [4,6) phi_NE_rad (level)   [6] phi_D_rad (heading)
 //   [7,9) dbg_xy_radps (gyro bias, body x, y)   [9,11) dba_xy_mps2 (accelerometer bias, body x, y)
-// The dynamics are the rows and columns of gnss_ins::ErrorDynamicsF (the GNSS/INS model)
+// The dynamics are the rows and columns of ins::ErrorDynamicsF (the GNSS/INS model)
 // for these states; the vertical channel is held by the barometric loop (free_ins.h).
 // Measurements: smoothed GPS position (gps_smoother.h) minus INS position, north and east,
 // with the smoother's measurement sigma. Every update is fed back into the INS.

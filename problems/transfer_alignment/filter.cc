@@ -7,7 +7,7 @@
 //   v_true = v + dv,  R_n_s_true = Exp(phi) R_n_s,  M_true = Exp(mu) M,  tau_true = tau + dtau.
 //
 // Propagation, per IMU sample (or part of one, when a master tag splits it): dv and phi
-// follow the INS error model of problems/gnss_ins/error_dynamics.h (its dv/phi rows and
+// follow the INS error model of problems/ins/error_dynamics.h (its dv/phi rows and
 // columns; the position errors are left out because the position is reset from the master
 // at every record, and the slave biases are not states), mu and dtau are random constants
 // with small random walks. Phi = I + F dt + (F dt)^2 / 2; Qd = diag(q) dt with
@@ -47,8 +47,8 @@
 #include "core/imu_split.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
-#include "problems/gnss_ins/error_dynamics.h"
-#include "problems/gnss_ins/ins_state.h"
+#include "problems/ins/error_dynamics.h"
+#include "problems/ins/ins_state.h"
 #include "problems/transfer_alignment/master.h"
 #include "solvers/eskf.h"
 
@@ -207,15 +207,15 @@ class TransferFilter {
 
   void Propagate(const ImuSample& s) {
     const double dt = s.dt_s;
-    gnss_ins::InsState x;
+    ins::InsState x;
     x.nav = ins_.state();
     const Vector3d f_s = s.dv_b_mps / dt, w_s = s.dtheta_b_rad / dt;
-    const Eigen::MatrixXd F15 = gnss_ins::ErrorDynamicsF(x, f_s, w_s, noise_, gnss_ins::err::kSize15);
+    const Eigen::MatrixXd F15 = ins::ErrorDynamicsF(x, f_s, w_s, noise_, ins::err::kSize15);
     Matrix10 F = Matrix10::Zero();
-    F.block<3, 3>(kVel, kVel) = F15.block<3, 3>(gnss_ins::err::kVel, gnss_ins::err::kVel);
-    F.block<3, 3>(kVel, kAtt) = F15.block<3, 3>(gnss_ins::err::kVel, gnss_ins::err::kAtt);
-    F.block<3, 3>(kAtt, kVel) = F15.block<3, 3>(gnss_ins::err::kAtt, gnss_ins::err::kVel);
-    F.block<3, 3>(kAtt, kAtt) = F15.block<3, 3>(gnss_ins::err::kAtt, gnss_ins::err::kAtt);
+    F.block<3, 3>(kVel, kVel) = F15.block<3, 3>(ins::err::kVel, ins::err::kVel);
+    F.block<3, 3>(kVel, kAtt) = F15.block<3, 3>(ins::err::kVel, ins::err::kAtt);
+    F.block<3, 3>(kAtt, kVel) = F15.block<3, 3>(ins::err::kAtt, ins::err::kVel);
+    F.block<3, 3>(kAtt, kAtt) = F15.block<3, 3>(ins::err::kAtt, ins::err::kAtt);
     const Matrix10 Fdt = F * dt;
     const Matrix10 Phi = Matrix10::Identity() + Fdt + 0.5 * Fdt * Fdt;
     const Matrix10 Qd = Matrix10((q_ * dt).asDiagonal());
@@ -323,7 +323,7 @@ class TransferFilter {
   ErrorStateKalmanFilter kf_;
   Eigen::Quaterniond misalignment_;
   double tau_s_ = 0.0;
-  gnss_ins::ImuNoise noise_;
+  ins::ImuNoise noise_;
   Vector10 q_ = Vector10::Zero();  // continuous process-noise PSD per state
 };
 

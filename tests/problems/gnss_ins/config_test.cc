@@ -1,6 +1,6 @@
 // The two configuration loaders: navtwin's YAML (units in the key names, errors naming
 // file, line and key) and KF-GINS' YAML taken unchanged.
-#include "problems/gnss_ins/ins_state.h"  // before config.h, which uses InsState
+#include "problems/gnss_ins/ins_vocabulary.h"  // before config.h, which uses InsState
 #include "problems/gnss_ins/config.h"
 
 #include <cmath>

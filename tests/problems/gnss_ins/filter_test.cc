@@ -26,13 +26,18 @@
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
 #include "core/sim/yaml_config.h"
-#include "problems/gnss_ins/error_dynamics.h"
+#include "problems/ins/error_dynamics.h"
 #include "problems/ins/nav_error.h"
 #include "solvers/eskf.h"
 #include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
 namespace {
+
+// The aided-INS layer's measurement rules (problems/ins), used by this filter.
+using ins::CalibrateMag;
+using ins::MeasurementSigma;
+using ins::StillnessDetector;
 
 using namespace test_records;  // SimRecord, SimulateRecord, ReadAll, Vec3, TruthAt
 
@@ -160,62 +165,6 @@ void Print(const char* name, const Rms& f, const Rms& s) {
 }
 
 // --------------------------------------------------------------------- building blocks
-
-/// Random symmetric positive definite n x n matrix with entries of order `scale`.
-Eigen::MatrixXd RandomSpd(int n, std::mt19937* rng) {
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd L(n, n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) L(i, j) = normal(*rng);
-  return L * L.transpose() / n + Eigen::MatrixXd::Identity(n, n);
-}
-
-TEST(GnssInsFilter, BlockCovariancePropagationEqualsDenseForm) {
-  std::mt19937 rng(7);
-  std::normal_distribution<double> normal;
-  for (const int n : {err::kSize15, err::kSize21}) {
-    SCOPED_TRACE(n);
-    InsState x;
-    x.nav.lat_rad = 0.7;
-    x.nav.h_m = 1200.0;
-    x.nav.v_n_mps = Eigen::Vector3d(40.0, -25.0, 3.0);
-    x.nav.q_n_b = QuatFromEuler(0.2, -0.1, 2.5);
-    x.imu.bg_radps = Eigen::Vector3d(1e-4, -2e-4, 3e-4);
-    x.imu.ba_mps2 = Eigen::Vector3d(0.05, -0.02, 0.03);
-    x.imu.sg = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
-    x.imu.sa = Eigen::Vector3d(-1e-3, 3e-3, 2e-3);
-    ImuNoise noise;
-    noise.gyro_arw_rad_per_sqrt_s = 1e-3;
-    noise.accel_vrw_mps_per_sqrt_s = 2e-2;
-    noise.gyro_bias_std_radps = 1e-3;
-    noise.accel_bias_std_mps2 = 0.2;
-    noise.gyro_scale_std = 1e-3;
-    noise.accel_scale_std = 2e-3;
-    noise.correlation_time_s = 300.0;
-    const Eigen::Vector3d f(1.5, -2.0, -9.6), w(0.1, -0.05, 0.2);
-    const double dt = 0.02;
-    // Scale the random covariance to realistic magnitudes per block (m, m/s, rad, ...).
-    Eigen::VectorXd s(n);
-    s << 3, 3, 3, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4, 0.01, 0.01, 0.01;
-    if (n == err::kSize21) s.tail<6>().setConstant(1e-3);
-    const Eigen::MatrixXd P0 = s.asDiagonal() * RandomSpd(n, &rng) * s.asDiagonal();
-    Eigen::MatrixXd X0 = Eigen::MatrixXd::Identity(n, n);
-    X0.topRows(9) += 0.1 * Eigen::MatrixXd::NullaryExpr(9, n, [&]() { return normal(rng); });
-
-    Eigen::MatrixXd Phi, Qd;
-    DiscreteErrorDynamics(x, f, w, noise, n, dt, &Phi, &Qd);
-    ErrorStateKalmanFilter kf(P0);
-    kf.Predict(Phi, Qd);
-    const Eigen::MatrixXd X_ref = Phi * X0;
-
-    Eigen::MatrixXd P = P0, X = X0;
-    PropagateCovariance(x, f, w, noise, dt, &P, &X);
-    // Same formulas, different summation order: agreement to rounding (1e-13 of the
-    // largest entry; P's entries span 1e-8 .. 10).
-    EXPECT_LT((P - kf.P()).cwiseAbs().maxCoeff(), 1e-13 * kf.P().cwiseAbs().maxCoeff());
-    EXPECT_LT((X - X_ref).cwiseAbs().maxCoeff(), 1e-13 * X_ref.cwiseAbs().maxCoeff());
-  }
-}
 
 TEST(GnssInsFilter, SigmasCalibrationAndInitialStd) {
   const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -19,7 +19,7 @@
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
 #include "core/sim/yaml_config.h"
-#include "problems/gnss_ins/error_dynamics.h"
+#include "problems/ins/error_dynamics.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/ins/nav_error.h"
 #include "solvers/eskf.h"

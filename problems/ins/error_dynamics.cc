@@ -1,4 +1,4 @@
-#include "problems/gnss_ins/error_dynamics.h"
+#include "problems/ins/error_dynamics.h"
 
 #include <cmath>
 #include <limits>
@@ -9,7 +9,7 @@
 #include "core/rotation.h"
 #include "factors/position_manifold.h"
 
-namespace navtwin::gnss_ins {
+namespace navtwin::ins {
 namespace {
 
 void CheckSize(int n, const char* what) {
@@ -40,6 +40,84 @@ void NormalGravityDerivatives(double lat, double h, double* dg_dlat, double* dg_
   const double dcorr_dh = -2.0 / kA_m * (1.0 + kF + kM - 2.0 * kF * s2) + 6.0 * h / (kA_m * kA_m);
   *dg_dlat = dg0 * corr + g0 * dcorr_dlat;
   *dg_dh = g0 * dcorr_dh;
+}
+
+/// x * y for small fixed-size matrices, coefficient-based (Eigen would otherwise take its
+/// blocked GEMM path, slow at 9 x 9).
+template <typename X, typename Y>
+auto Mul(const Eigen::MatrixBase<X>& x, const Eigen::MatrixBase<Y>& y) {
+  return x.lazyProduct(y).eval();
+}
+
+/// PropagateCovariance for S IMU-error states (6 or 12) followed by aux_psd.size()
+/// auxiliary random walks; see error_dynamics.h for the block form.
+template <int S>
+void PropagateBlocks(const Eigen::MatrixXd& F, const Eigen::MatrixXd& G, const Eigen::VectorXd& qc,
+                     double dt, const Eigen::VectorXd& aux_psd, Eigen::MatrixXd* P, Eigen::MatrixXd* phi_acc) {
+  constexpr int N = 9;  // navigation states: dp, dv, phi
+  using MatNN = Eigen::Matrix<double, N, N>;
+  using MatNS = Eigen::Matrix<double, N, S>;
+  using MatSS = Eigen::Matrix<double, S, S>;
+  // F dt = [[a, b], [0, c]]  =>  (F dt)^2 = [[a^2, a b + b c], [0, c^2]] and
+  // Phi = [[A, B], [0, D]] = I + F dt + (F dt)^2 / 2.
+  const MatNN a = F.topLeftCorner<N, N>() * dt;
+  const MatNS b = F.topRightCorner<N, S>() * dt;
+  const MatSS c = F.bottomRightCorner<S, S>() * dt;
+  MatNN A = a + 0.5 * Mul(a, a);
+  A.diagonal().array() += 1.0;
+  const MatNS B = b + 0.5 * (Mul(a, b) + Mul(b, c));
+  MatSS D = c + 0.5 * Mul(c, c);
+  D.diagonal().array() += 1.0;
+  // G Qc G^T = blockdiag(Qn, diag(qs)).
+  const Eigen::Matrix<double, N, 6> Gn = G.topLeftCorner<N, 6>();
+  const Eigen::Matrix<double, N, 6> Gq = Gn * qc.head<6>().asDiagonal();
+  const MatNN Qn = Mul(Gq, Gn.transpose());
+  // G maps the IMU-error driving noises w[6 .. 6 + S) onto the IMU-error rows (identity).
+  const Eigen::Matrix<double, S, 1> qs = qc.segment<S>(6);
+  // Phi P Phi^T with P = [[Pnn, Pns], [Pns^T, Pss]].
+  const MatNN Pnn = P->topLeftCorner<N, N>();
+  const MatNS Pns = P->block<N, S>(0, N);
+  const MatSS Pss = P->block<S, S>(N, N);
+  const MatNN M1 = Mul(A, Pnn) + Mul(B, Pns.transpose());
+  const MatNS M2 = Mul(A, Pns) + Mul(B, Pss);
+  MatNN Nnn = Mul(M1, A.transpose()) + Mul(M2, B.transpose());
+  MatNS Nns = Mul(M2, D.transpose());
+  MatSS Nss = Mul(Mul(D, Pss), D.transpose());
+  // + Qd = dt/2 (Phi GQG Phi^T + GQG), Phi GQG Phi^T = [[A Qn A^T + B Qs B^T, B Qs D^T], [., D Qs D^T]].
+  const MatNS Bq = B * qs.asDiagonal();
+  Nnn += (0.5 * dt) * (Mul(Mul(A, Qn), A.transpose()) + Mul(Bq, B.transpose()) + Qn);
+  Nns += (0.5 * dt) * Mul(Bq, D.transpose());
+  const MatSS Dq = D * qs.asDiagonal();
+  MatSS Qss = Mul(Dq, D.transpose());
+  Qss.diagonal() += qs;
+  Nss += (0.5 * dt) * Qss;
+  P->topLeftCorner<N, N>() = 0.5 * (Nnn + Nnn.transpose());
+  P->block<N, S>(0, N) = Nns;
+  P->block<S, N>(N, 0) = Nns.transpose();
+  P->block<S, S>(N, N) = 0.5 * (Nss + Nss.transpose());
+  const int n_aux = static_cast<int>(aux_psd.size());
+  if (n_aux > 0) {
+    // Auxiliary random walks: [[Phi, 0], [0, I]], so P_ia <- Phi P_ia, P_aa += q dt.
+    const Eigen::MatrixXd Pna = P->block(0, N + S, N, n_aux);
+    const Eigen::MatrixXd Psa = P->block(N, N + S, S, n_aux);
+    const Eigen::MatrixXd Nna = A * Pna + B * Psa;
+    const Eigen::MatrixXd Nsa = D * Psa;
+    P->block(0, N + S, N, n_aux) = Nna;
+    P->block(N + S, 0, n_aux, N) = Nna.transpose();
+    P->block(N, N + S, S, n_aux) = Nsa;
+    P->block(N + S, N, n_aux, S) = Nsa.transpose();
+    P->bottomRightCorner(n_aux, n_aux).diagonal() += aux_psd * dt;
+  }
+  if (phi_acc != nullptr) {
+    // [[A, B], [0, D]] [[Xnn, Xns], [0, Xss]] = [[A Xnn, A Xns + B Xss], [0, D Xss]]; the
+    // auxiliary block of the product stays I.
+    const MatNN Xnn = phi_acc->topLeftCorner<N, N>();
+    const MatNS Xns = phi_acc->block<N, S>(0, N);
+    const MatSS Xss = phi_acc->block<S, S>(N, N);
+    phi_acc->topLeftCorner<N, N>() = Mul(A, Xnn);
+    phi_acc->block<N, S>(0, N) = Mul(A, Xns) + Mul(B, Xss);
+    phi_acc->block<S, S>(N, N) = Mul(D, Xss);
+  }
 }
 
 }  // namespace
@@ -182,6 +260,29 @@ void DiscreteErrorDynamics(const InsState& x, const Eigen::Vector3d& f_b_mps2,
   if (Phi) *Phi = std::move(phi);
 }
 
+void PropagateCovariance(const InsState& x, const Eigen::Vector3d& f_b_mps2,
+                         const Eigen::Vector3d& omega_ib_b_radps, const ImuNoise& noise, double dt_s,
+                         Eigen::MatrixXd* P, Eigen::MatrixXd* phi_acc, const Eigen::VectorXd& aux_psd) {
+  const int total = static_cast<int>(P->rows());
+  const int n = total - static_cast<int>(aux_psd.size());
+  if ((n != err::kSize15 && n != err::kSize21) || P->cols() != total ||
+      (phi_acc != nullptr && (phi_acc->rows() != total || phi_acc->cols() != total))) {
+    throw std::invalid_argument(
+        "PropagateCovariance: P (and phi_acc) must be 15 x 15 or 21 x 21 plus the auxiliary states");
+  }
+  if (!(dt_s >= 0.0) || !std::isfinite(dt_s)) {
+    throw std::invalid_argument("PropagateCovariance: dt_s must be finite and non-negative");
+  }
+  const Eigen::MatrixXd F = ErrorDynamicsF(x, f_b_mps2, omega_ib_b_radps, noise, n);
+  const Eigen::MatrixXd G = ErrorDynamicsG(x, n);
+  const Eigen::VectorXd qc = ErrorDynamicsQc(noise, n);
+  if (n == err::kSize15) {
+    PropagateBlocks<6>(F, G, qc, dt_s, aux_psd, P, phi_acc);
+  } else {
+    PropagateBlocks<12>(F, G, qc, dt_s, aux_psd, P, phi_acc);
+  }
+}
+
 InsState ApplyCorrection(const InsState& x, const Eigen::VectorXd& dx) {
   const int n = static_cast<int>(dx.size());
   CheckSize(n, "ApplyCorrection");
@@ -225,4 +326,4 @@ Eigen::VectorXd StateDifference(const InsState& y, const InsState& x, int n) {
   return dx;
 }
 
-}  // namespace navtwin::gnss_ins
+}  // namespace navtwin::ins

@@ -1,5 +1,6 @@
-// The state shared by the GNSS/INS filter, its RTS smoother and the batch smoother, and
-// the layout of the error state that all three use (docs/gnss-ins.md).
+// The aided-INS state shared by every filter, RTS smoother and batch smoother built on
+// the strapdown mechanization, and the layout of the error state they use
+// (docs/ins-error-model.md, docs/architecture.md).
 //
 // Error state (true minus estimate), 15 or 21 components:
 //   [ 0, 3)  dp_ned_m     position error in local NED metres:
@@ -21,7 +22,7 @@
 
 #include "core/types.h"
 
-namespace navtwin::gnss_ins {
+namespace navtwin::ins {
 
 /// Indices of the error-state blocks.
 namespace err {
@@ -60,9 +61,15 @@ inline ImuSample CorrectImu(const ImuSample& raw, const ImuErrors& e) {
 
 /// A state of a solution with the standard deviations of its error state (15 or 21
 /// entries, the layout above; empty when not computed). Units: m, m/s, rad, rad/s, m/s^2, -.
+/// aux: the auxiliary states that aiding sources add (e.g. an odometer scale factor;
+/// problems/ins/aiding.h) in the order of the sources' registration, their errors
+/// (true minus estimate) appended after the INS error states; aux_std their standard
+/// deviations (empty when not computed).
 struct NavEpoch {
   InsState state;
   Eigen::VectorXd std;
+  Eigen::VectorXd aux;
+  Eigen::VectorXd aux_std;
 };
 
-}  // namespace navtwin::gnss_ins
+}  // namespace navtwin::ins

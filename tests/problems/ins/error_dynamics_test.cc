@@ -1,8 +1,9 @@
-#include "problems/gnss_ins/error_dynamics.h"
+#include "problems/ins/error_dynamics.h"
 
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <random>
 #include <stdexcept>
 #include <vector>
 
@@ -12,8 +13,9 @@
 #include "core/rotation.h"
 #include "core/strapdown.h"
 #include "factors/position_manifold.h"
+#include "solvers/eskf.h"
 
-namespace navtwin::gnss_ins {
+namespace navtwin::ins {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -371,5 +373,111 @@ TEST(ErrorDynamics, CorrectionAndDifferenceAreInverse) {
   EXPECT_LT(AttitudeError(back.nav.q_n_b, y.nav.q_n_b).norm(), 1e-15);
 }
 
+// --------------------------------------------------------------- covariance propagation
+
+/// Random symmetric positive definite n x n matrix with entries of order `scale`.
+Eigen::MatrixXd RandomSpd(int n, std::mt19937* rng) {
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd L(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) L(i, j) = normal(*rng);
+  return L * L.transpose() / n + Eigen::MatrixXd::Identity(n, n);
+}
+
+TEST(PropagateCovariance, BlockFormEqualsDenseForm) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  for (const int n : {err::kSize15, err::kSize21}) {
+    SCOPED_TRACE(n);
+    InsState x;
+    x.nav.lat_rad = 0.7;
+    x.nav.h_m = 1200.0;
+    x.nav.v_n_mps = Eigen::Vector3d(40.0, -25.0, 3.0);
+    x.nav.q_n_b = QuatFromEuler(0.2, -0.1, 2.5);
+    x.imu.bg_radps = Eigen::Vector3d(1e-4, -2e-4, 3e-4);
+    x.imu.ba_mps2 = Eigen::Vector3d(0.05, -0.02, 0.03);
+    x.imu.sg = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+    x.imu.sa = Eigen::Vector3d(-1e-3, 3e-3, 2e-3);
+    ImuNoise noise;
+    noise.gyro_arw_rad_per_sqrt_s = 1e-3;
+    noise.accel_vrw_mps_per_sqrt_s = 2e-2;
+    noise.gyro_bias_std_radps = 1e-3;
+    noise.accel_bias_std_mps2 = 0.2;
+    noise.gyro_scale_std = 1e-3;
+    noise.accel_scale_std = 2e-3;
+    noise.correlation_time_s = 300.0;
+    const Eigen::Vector3d f(1.5, -2.0, -9.6), w(0.1, -0.05, 0.2);
+    const double dt = 0.02;
+    // Scale the random covariance to realistic magnitudes per block (m, m/s, rad, ...).
+    Eigen::VectorXd s(n);
+    s << 3, 3, 3, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4, 0.01, 0.01, 0.01;
+    if (n == err::kSize21) s.tail<6>().setConstant(1e-3);
+    const Eigen::MatrixXd P0 = s.asDiagonal() * RandomSpd(n, &rng) * s.asDiagonal();
+    Eigen::MatrixXd X0 = Eigen::MatrixXd::Identity(n, n);
+    X0.topRows(9) += 0.1 * Eigen::MatrixXd::NullaryExpr(9, n, [&]() { return normal(rng); });
+
+    Eigen::MatrixXd Phi, Qd;
+    DiscreteErrorDynamics(x, f, w, noise, n, dt, &Phi, &Qd);
+    ErrorStateKalmanFilter kf(P0);
+    kf.Predict(Phi, Qd);
+    const Eigen::MatrixXd X_ref = Phi * X0;
+
+    Eigen::MatrixXd P = P0, X = X0;
+    PropagateCovariance(x, f, w, noise, dt, &P, &X);
+    // Same formulas, different summation order: agreement to rounding (1e-13 of the
+    // largest entry; P's entries span 1e-8 .. 10).
+    EXPECT_LT((P - kf.P()).cwiseAbs().maxCoeff(), 1e-13 * kf.P().cwiseAbs().maxCoeff());
+    EXPECT_LT((X - X_ref).cwiseAbs().maxCoeff(), 1e-13 * X_ref.cwiseAbs().maxCoeff());
+  }
+}
+
+
+// Auxiliary states of aiding sources (random constants appended to the error state): the
+// block form equals the dense one with Phi_aug = blockdiag(Phi, I), Qd_aug = blockdiag(Qd,
+// q dt), including their correlations with the INS states and the RTS transition product.
+TEST(PropagateCovariance, AuxiliaryStatesFollowTheAugmentedDenseForm) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal;
+  const int n = err::kSize15, n_aux = 2, total = n + n_aux;
+  InsState x;
+  x.nav.lat_rad = -0.5;
+  x.nav.h_m = 80.0;
+  x.nav.v_n_mps = Eigen::Vector3d(12.0, 4.0, -0.2);
+  x.nav.q_n_b = QuatFromEuler(0.02, -0.03, 1.1);
+  x.imu.bg_radps = Eigen::Vector3d(2e-5, -1e-5, 3e-5);
+  x.imu.ba_mps2 = Eigen::Vector3d(0.01, -0.02, 0.005);
+  ImuNoise noise;
+  noise.gyro_arw_rad_per_sqrt_s = 1e-4;
+  noise.accel_vrw_mps_per_sqrt_s = 2e-3;
+  noise.gyro_bias_std_radps = 5e-5;
+  noise.accel_bias_std_mps2 = 0.02;
+  noise.correlation_time_s = 600.0;
+  const Eigen::Vector3d f(0.5, 1.0, -9.8), w(0.0, 0.01, 0.3);
+  const double dt = 0.02;
+  const Eigen::VectorXd aux_psd = Eigen::Vector2d(1e-6, 0.0);
+  Eigen::VectorXd s(total);
+  s << 3, 3, 3, 0.1, 0.1, 0.1, 0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4, 0.01, 0.01, 0.01, 0.01, 0.05;
+  const Eigen::MatrixXd P0 = s.asDiagonal() * RandomSpd(total, &rng) * s.asDiagonal();
+  Eigen::MatrixXd X0 = Eigen::MatrixXd::Identity(total, total);
+  X0.block(0, 0, 9, n) += 0.1 * Eigen::MatrixXd::NullaryExpr(9, n, [&]() { return normal(rng); });
+
+  Eigen::MatrixXd Phi, Qd;
+  DiscreteErrorDynamics(x, f, w, noise, n, dt, &Phi, &Qd);
+  Eigen::MatrixXd Phi_aug = Eigen::MatrixXd::Identity(total, total), Qd_aug = Eigen::MatrixXd::Zero(total, total);
+  Phi_aug.topLeftCorner(n, n) = Phi;
+  Qd_aug.topLeftCorner(n, n) = Qd;
+  Qd_aug.bottomRightCorner(n_aux, n_aux).diagonal() = aux_psd * dt;
+  const Eigen::MatrixXd P_ref = Phi_aug * P0 * Phi_aug.transpose() + Qd_aug;
+  const Eigen::MatrixXd X_ref = Phi_aug * X0;
+
+  Eigen::MatrixXd P = P0, X = X0;
+  PropagateCovariance(x, f, w, noise, dt, &P, &X, aux_psd);
+  EXPECT_LT((P - P_ref).cwiseAbs().maxCoeff(), 1e-13 * P_ref.cwiseAbs().maxCoeff());
+  EXPECT_LT((X - X_ref).cwiseAbs().maxCoeff(), 1e-13 * X_ref.cwiseAbs().maxCoeff());
+  // A size that fits neither 15 nor 21 INS states plus the auxiliary ones is refused.
+  Eigen::MatrixXd wrong = Eigen::MatrixXd::Identity(total + 1, total + 1);
+  EXPECT_THROW(PropagateCovariance(x, f, w, noise, dt, &wrong, nullptr, aux_psd), std::invalid_argument);
+}
+
 }  // namespace
-}  // namespace navtwin::gnss_ins
+}  // namespace navtwin::ins

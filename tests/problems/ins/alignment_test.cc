@@ -1,4 +1,4 @@
-#include "problems/gnss_ins/alignment.h"
+#include "problems/ins/alignment.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -9,7 +9,7 @@
 #include "core/earth.h"
 #include "core/rotation.h"
 
-namespace navtwin::gnss_ins {
+namespace navtwin::ins {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
@@ -120,4 +120,4 @@ TEST(AttitudeFromGnssVelocity, LevelWithVelocityHeading) {
 }
 
 }  // namespace
-}  // namespace navtwin::gnss_ins
+}  // namespace navtwin::ins

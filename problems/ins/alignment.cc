@@ -1,4 +1,4 @@
-#include "problems/gnss_ins/alignment.h"
+#include "problems/ins/alignment.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -7,7 +7,7 @@
 #include "core/earth.h"
 #include "core/rotation.h"
 
-namespace navtwin::gnss_ins {
+namespace navtwin::ins {
 namespace {
 
 // Limits for "clearly not static": the mean specific force must be gravity to within
@@ -80,4 +80,13 @@ Eigen::Quaterniond AttitudeFromGnssVelocity(const Eigen::Vector3d& v_n_mps) {
   return QuatFromEuler<double>(0.0, 0.0, std::atan2(v_n_mps.y(), v_n_mps.x()));
 }
 
-}  // namespace navtwin::gnss_ins
+void ImuPositionFromAntenna(const GnssSample& fix, const Eigen::Quaterniond& q_n_b,
+                            const Eigen::Vector3d& lever_arm_b_m, NavState* nav) {
+  const wgs84::Geodetic p =
+      wgs84::NedToGeodetic(-(q_n_b * lever_arm_b_m), {fix.lat_rad, fix.lon_rad, fix.h_m});
+  nav->lat_rad = p.lat_rad;
+  nav->lon_rad = p.lon_rad;
+  nav->h_m = p.h_m;
+}
+
+}  // namespace navtwin::ins

@@ -11,7 +11,7 @@
 
 #include "core/types.h"
 
-namespace navtwin::gnss_ins {
+namespace navtwin::ins {
 
 /// Static coarse alignment from body-axes IMU samples over a still interval: roll and
 /// pitch from the mean specific force, heading from the mean angular rate (gyrocompassing;
@@ -36,4 +36,9 @@ Eigen::Quaterniond StaticCoarseAlignment(const std::vector<ImuSample>& samples, 
 /// or not finite.
 Eigen::Quaterniond AttitudeFromGnssVelocity(const Eigen::Vector3d& v_n_mps);
 
-}  // namespace navtwin::gnss_ins
+/// The IMU reference point from an antenna fix: p_imu = p_ant - R_n_b l_b (exact, through
+/// the local NED frame of the fix); sets nav's lat_rad, lon_rad, h_m.
+void ImuPositionFromAntenna(const GnssSample& fix, const Eigen::Quaterniond& q_n_b,
+                            const Eigen::Vector3d& lever_arm_b_m, NavState* nav);
+
+}  // namespace navtwin::ins
