@@ -6,9 +6,36 @@
 #include "core/io/input_error.h"
 
 namespace navtwin {
+namespace {
+
+/// The first alternative's column that the header has (one alternative: RequireWithUnit).
+UnitColumn ValueColumn(const HeaderColumns& header, std::initializer_list<SeriesColumn> alternatives,
+                       const std::string& path, long line, std::string* stem) {
+  if (alternatives.size() == 1) {
+    *stem = alternatives.begin()->stem;
+    return header.RequireWithUnit(*stem, alternatives.begin()->units);
+  }
+  std::string tried;
+  for (const SeriesColumn& c : alternatives) {
+    const UnitColumn column = header.FindWithUnit(c.stem, c.units);
+    if (column.index >= 0) {
+      *stem = c.stem;
+      return column;
+    }
+    for (const UnitSuffix& u : c.units) tried += (tried.empty() ? "'" : " or '") + c.stem + u.suffix + "'";
+  }
+  throw InputError(path, line, alternatives.begin()->stem, "missing column " + tried);
+}
+
+}  // namespace
 
 ScalarSeries ReadScalarSeriesCsv(const std::string& path, const std::string& stem,
                                  std::initializer_list<UnitSuffix> units, double lo, double hi) {
+  return ReadScalarSeriesCsv(path, {SeriesColumn{stem, units}}, lo, hi);
+}
+
+ScalarSeries ReadScalarSeriesCsv(const std::string& path, std::initializer_list<SeriesColumn> alternatives,
+                                 double lo, double hi) {
   ScalarSeries out;
   out.path = path;
   LineReader lines(path);
@@ -25,7 +52,7 @@ ScalarSeries ReadScalarSeriesCsv(const std::string& path, const std::string& ste
       SplitCsv(line, &fields);
       header = HeaderColumns(fields, path, lines.line_number());
       time = header.RequireWithUnit("t", {{"_s", 1.0}, {"_ms", 1e-3}});
-      column = header.RequireWithUnit(stem, units);
+      column = ValueColumn(header, alternatives, path, lines.line_number(), &out.stem);
       have_header = true;
       continue;
     }

@@ -17,6 +17,7 @@ namespace navtwin {
 
 struct ScalarSeries {
   std::string path;
+  std::string stem;           ///< the value column's stem (of the alternatives, the one found)
   std::vector<double> t_s;
   std::vector<double> value;  ///< SI (the unit suffix's scale applied)
 };
@@ -26,6 +27,17 @@ struct ScalarSeries {
 /// missing column, a bad or non-finite number, a short row, time not increasing, an empty file.
 ScalarSeries ReadScalarSeriesCsv(const std::string& path, const std::string& stem,
                                  std::initializer_list<UnitSuffix> units,
+                                 double lo = -std::numeric_limits<double>::infinity(),
+                                 double hi = std::numeric_limits<double>::infinity());
+
+/// One value column of several alternatives: the first stem whose column (with one of its
+/// units) the header has; the others as above. A header with none of them is an InputError
+/// naming every alternative.
+struct SeriesColumn {
+  std::string stem;
+  std::initializer_list<UnitSuffix> units;
+};
+ScalarSeries ReadScalarSeriesCsv(const std::string& path, std::initializer_list<SeriesColumn> alternatives,
                                  double lo = -std::numeric_limits<double>::infinity(),
                                  double hi = std::numeric_limits<double>::infinity());
 

@@ -26,6 +26,7 @@
 #include "core/sim/random.h"
 #include "core/sim/truth.h"
 #include "core/sim/yaml_config.h"
+#include "core/io/csv_odometer.h"
 #include "core/types.h"
 
 namespace navtwin::sim {
@@ -221,6 +222,38 @@ class BaroSimulator {
   BaroSimConfig config_;
   bool perfect_;
   double bias_m_ = 0.0;
+  EpochSampler sampler_;
+  Rng noise_rng_;
+};
+
+// --------------------------------------------------------------------------- odometer
+
+/// `odometer:` (SI inside): a wheel odometer at the vehicle reference point lever_arm_b_m
+/// (body axes; the simulated vehicle frame is the body frame).
+struct OdometerSimConfig {
+  double rate_hz = 10.0;
+  double scale_factor_sigma = 0.0;  ///< 1-sigma of a per-run constant scale-factor error
+  std::optional<double> scale_factor_fixed;
+  double noise_mps = 0.0;           ///< white noise, 1-sigma
+  Eigen::Vector3d lever_arm_b_m = Eigen::Vector3d::Zero();
+};
+
+/// YAML keys: rate_hz, scale_factor_ppm | scale_factor_fixed_ppm, noise_mps, lever_arm_b_m.
+OdometerSimConfig ParseOdometerSimConfig(const ConfigNode& node);
+
+/// Odometer: speed_mps = (1 + s) [R_n_b^T v_n + omega_ib_b x l_b]_x + n, the forward
+/// speed of the reference point with a constant scale-factor error s and white noise n.
+class OdometerSimulator {
+ public:
+  OdometerSimulator(const OdometerSimConfig& config, const Rng& rng, bool perfect);
+  std::optional<OdometerSample> Push(const TruthSample& truth);
+  void EmitDrawn(YAML::Emitter& out) const;
+  double scale_factor() const { return scale_factor_; }
+
+ private:
+  OdometerSimConfig config_;
+  bool perfect_;
+  double scale_factor_ = 0.0;
   EpochSampler sampler_;
   Rng noise_rng_;
 };

@@ -36,7 +36,7 @@ InitErrorConfig ParseInitErrors(const ConfigNode& node) {
 
 Scenario ParseScenario(const ConfigNode& root) {
   root.RequireKeys({"name", "description", "duration_s", "start", "trajectory", "imu", "gnss",
-                    "mag", "baro", "master", "init_errors"});
+                    "mag", "baro", "odometer", "master", "init_errors"});
   Scenario s;
   s.name = root.String("name", "unnamed");
   s.description = root.String("description", "");
@@ -63,6 +63,7 @@ Scenario ParseScenario(const ConfigNode& root) {
   if (root.Has("gnss")) s.gnss = ParseGnssSimConfig(root.Child("gnss"));
   if (root.Has("mag")) s.mag = ParseMagSimConfig(root.Child("mag"));
   if (root.Has("baro")) s.baro = ParseBaroSimConfig(root.Child("baro"));
+  if (root.Has("odometer")) s.odometer = ParseOdometerSimConfig(root.Child("odometer"));
   if (root.Has("master")) s.master = ParseMasterSimConfig(root.Child("master"));
   s.init_errors = ParseInitErrors(root.Child("init_errors"));
   return s;

@@ -38,6 +38,7 @@ struct Scenario {
   std::optional<GnssSimConfig> gnss;
   std::optional<MagSimConfig> mag;
   std::optional<BaroSimConfig> baro;
+  std::optional<OdometerSimConfig> odometer;
   std::optional<MasterSimConfig> master;
   InitErrorConfig init_errors;
 };

@@ -123,6 +123,12 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
     baro = std::make_unique<BaroSimulator>(*scenario.baro, rng.Stream("baro"), perfect);
     baro_out = std::make_unique<CsvBaroWriter>(path("baro.csv"));
   }
+  std::unique_ptr<OdometerSimulator> odometer;
+  std::unique_ptr<CsvOdometerWriter> odometer_out;
+  if (scenario.odometer) {
+    odometer = std::make_unique<OdometerSimulator>(*scenario.odometer, rng.Stream("odometer"), perfect);
+    odometer_out = std::make_unique<CsvOdometerWriter>(path("odometer.csv"));
+  }
   std::unique_ptr<MasterSimulator> master;
   std::unique_ptr<KfginsNavWriter> master_out;
   if (scenario.master) {
@@ -159,6 +165,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
     PushAndWrite(gnss.get(), gnss_out.get(), t, &report.gnss_samples);
     PushAndWrite(mag.get(), mag_out.get(), t, &report.mag_samples);
     PushAndWrite(baro.get(), baro_out.get(), t, &report.baro_samples);
+    PushAndWrite(odometer.get(), odometer_out.get(), t, &report.odometer_samples);
     PushAndWrite(master.get(), master_out.get(), t, &report.master_samples);
     if (options.progress && k % progress_step == 0) options.progress(static_cast<double>(k) / n);
   }
@@ -185,6 +192,10 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
     y << YAML::Key << "baro" << YAML::Value;
     baro->EmitDrawn(y);
   }
+  if (odometer) {
+    y << YAML::Key << "odometer" << YAML::Value;
+    odometer->EmitDrawn(y);
+  }
   if (master) {
     y << YAML::Key << "master" << YAML::Value;
     master->EmitDrawn(y);
@@ -209,6 +220,7 @@ SimulationReport Simulate(const Scenario& scenario, const SimulationOptions& opt
   if (gnss_out) gnss_out->Commit();
   if (mag_out) mag_out->Commit();
   if (baro_out) baro_out->Commit();
+  if (odometer_out) odometer_out->Commit();
   if (master_out) master_out->Commit();
   errors.Commit();
   report.run_time_s =

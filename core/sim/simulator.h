@@ -37,6 +37,7 @@ struct SimulationReport {
   std::size_t gnss_samples = 0;
   std::size_t mag_samples = 0;
   std::size_t baro_samples = 0;
+  std::size_t odometer_samples = 0;
   std::size_t master_samples = 0;
   double run_time_s = 0.0;
 };

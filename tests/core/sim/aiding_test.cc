@@ -3,6 +3,7 @@
 // configuration parsing. Random tests use fixed seeds.
 #include "core/sim/aiding.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -415,6 +416,46 @@ TEST(AidingTest, BarometerBiasAndNoise) {
   const auto out = Feed<BaroSample>(perfect, StaticStream(100.0, 2));
   EXPECT_EQ(out[0].altitude_m, kStart.h_m);
   EXPECT_NEAR(out[0].temperature_degC, IsaTemperature_K(kStart.h_m) - 273.15, 1e-12);
+}
+
+// ----------------------------------------------------------------------- odometer
+
+// The odometer reads the forward speed of its reference point: on the Wobble trajectory
+// (body rates to 3 rad/s) the perfect odometer at a lever arm equals [R_b_n v_n + omega x
+// l]_x of the interpolated truth, and the scale factor multiplies it exactly.
+TEST(AidingTest, OdometerReadsTheForwardSpeedOfItsReferencePoint) {
+  const Wobble trajectory;
+  const std::vector<TruthSample> truth = TruthStream(trajectory, 200.0, 3.0);
+  OdometerSimConfig c;
+  c.rate_hz = 10.0;
+  c.lever_arm_b_m = Eigen::Vector3d(-1.2, 0.3, 0.4);
+  c.scale_factor_fixed = 0.01;
+  c.noise_mps = 0.05;
+  OdometerSimulator perfect(c, Rng(3), true);
+  OdometerSimulator scaled(c, Rng(3), false);
+  const std::vector<OdometerSample> p = Feed<OdometerSample>(perfect, truth);
+  ASSERT_EQ(p.size(), 31u);  // t = 0, 0.1, ..., 3.0
+  for (const OdometerSample& s : p) {
+    const auto at = std::find_if(truth.begin(), truth.end(), [&](const TruthSample& t) { return std::abs(t.t_s - s.t_s) < 1e-9; });
+    ASSERT_NE(at, truth.end());
+    const Eigen::Vector3d v_b =
+        at->state.q_n_b.conjugate() * at->state.v_n_mps + at->omega_ib_b_rad_s.cross(c.lever_arm_b_m);
+    EXPECT_NEAR(s.speed_mps, v_b.x(), 1e-9);
+  }
+  EXPECT_EQ(scaled.scale_factor(), 0.01);
+  // Noise: the residual of the scaled reading has the configured sigma (30 samples: loose).
+  double sum_sq = 0.0;
+  const std::vector<OdometerSample> n = Feed<OdometerSample>(scaled, truth);
+  for (std::size_t k = 0; k < n.size(); ++k) sum_sq += std::pow(n[k].speed_mps - 1.01 * p[k].speed_mps, 2);
+  EXPECT_NEAR(std::sqrt(sum_sq / n.size()), 0.05, 0.02);
+  // Parsed from YAML in people units.
+  const OdometerSimConfig y = ParseOdometerSimConfig(
+      Yaml("odometer: {rate_hz: 20, scale_factor_ppm: 3000, noise_mps: 0.1, lever_arm_b_m: [1, 0, 0]}")
+          .Child("odometer"));
+  EXPECT_EQ(y.rate_hz, 20.0);
+  EXPECT_NEAR(y.scale_factor_sigma, 3e-3, 1e-15);
+  ExpectConfigError([&] { ParseOdometerSimConfig(Yaml("odometer: {noise_mps: -1}").Child("odometer")); },
+                    "noise_mps");
 }
 
 // --------------------------------------------------------------------- master INS
