@@ -63,6 +63,7 @@ DEFINE_double(outage_period_s, 0.0, "Injected GNSS outages: period, s (0: a sing
 DEFINE_string(demo_scenario, "mems-gps-mag-maneuver", "smooth --demo: the simulated scenario (a preset name or a scenario YAML)");
 DEFINE_bool(nhc, false, "Ground vehicles: the non-holonomic constraint (no lateral or vertical velocity of the vehicle reference point), on top of --config or --kfgins_config");
 DEFINE_double(nhc_sigma_mps, NAN, "Sigma of the non-holonomic constraint, m/s (default: the configuration's nhc.std_mps, 0.1)");
+DEFINE_string(odometer, "", "Wheel-odometer file (t_s,speed_mps or t_s,distance_m): the forward speed of the vehicle reference point, its scale factor estimated (default: the configuration's odometer.file)");
 DEFINE_string(vehicle_mounting_rpy_deg, "", "Roll,pitch,yaw of the IMU (body) axes in the vehicle frame, deg, e.g. 0,0,1.5 (default: the configuration's vehicle.mounting_rpy_deg)");
 DEFINE_string(vehicle_lever_arm_b_m, "", "x,y,z of the vehicle reference point (where NHC holds and the odometer measures) from the IMU, body axes, m (default: the configuration's vehicle.lever_arm_b_m)");
 DEFINE_string(demo_mag, "vector", "smooth --demo: magnetometer use, off|vector|heading|heading_2axis");
@@ -105,6 +106,7 @@ bool ParseTriple(const std::string& text, Eigen::Vector3d* out) {
 /// bad value (empty: fine).
 std::string ApplyVehicleFlags(GnssInsConfig* config) {
   if (FLAGS_nhc) config->nhc.enabled = true;
+  if (!FLAGS_odometer.empty()) config->odometer.file = FLAGS_odometer;
   if (!std::isnan(FLAGS_nhc_sigma_mps)) {
     if (!(FLAGS_nhc_sigma_mps > 0.0) || !std::isfinite(FLAGS_nhc_sigma_mps)) return "--nhc_sigma_mps must be > 0";
     config->nhc.std_mps = FLAGS_nhc_sigma_mps;
@@ -548,13 +550,13 @@ const char* const kNavigateUsage =
     "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
-    "[--nhc [--nhc_sigma_mps S]] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
+    "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
-    "[--nhc [--nhc_sigma_mps S]] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
+    "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--format=json]\n"
     "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
 
@@ -569,8 +571,8 @@ Command NavigateCommand() {
           kNavigateUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "smoother", "truth",
            "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
-           "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps", "vehicle_mounting_rpy_deg",
-           "vehicle_lever_arm_b_m"},
+           "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps", "odometer",
+           "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m"},
           &RunNavigate};
 }
 
@@ -581,7 +583,7 @@ Command SmoothCommand() {
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "truth", "output_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
            "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps",
-           "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m"},
+           "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m"},
           &RunSmooth};
 }
 

@@ -351,6 +351,15 @@ NhcConfig ParseNhc(const ConfigNode& n) {
   return x;
 }
 
+ins::OdometerConfig ParseOdometer(const ConfigNode& n, const std::string& config_path) {
+  n.RequireKeys({"file", "std_mps", "scale_std_ppm"});
+  ins::OdometerConfig x;
+  if (n.Has("file")) x.file = Resolve(config_path, n.String("file", ""));
+  x.std_mps = Sigma(n, "std_mps", x.std_mps);
+  x.scale_std = NonNegative(n, "scale_std_ppm", x.scale_std * 1e6) * 1e-6;
+  return x;
+}
+
 VehicleConfig ParseVehicle(const ConfigNode& n) {
   n.RequireKeys({"mounting_rpy_deg", "lever_arm_b_m"});
   VehicleConfig x;
@@ -484,7 +493,7 @@ void CrossCheckRate(const std::string& config_path, long line, const std::string
 
 GnssInsConfig LoadGnssInsConfig(const std::string& path) {
   const ConfigNode root = sim::LoadYamlFile(path);
-  root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "nhc", "vehicle", "gnss",
+  root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "nhc", "odometer", "vehicle", "gnss",
                     "outages", "filter", "batch", "output_rate_hz", "start_s", "end_s"});
   if (!root.Has("imu_noise")) root.Fail("imu_noise", "required");
   GnssInsConfig c;
@@ -503,6 +512,7 @@ GnssInsConfig LoadGnssInsConfig(const std::string& path) {
   c.baro = ParseBaro(root.Child("baro"));
   c.zupt = ParseZupt(root.Child("zupt"));
   c.nhc = ParseNhc(root.Child("nhc"));
+  c.odometer = ParseOdometer(root.Child("odometer"), path);
   c.vehicle = ParseVehicle(root.Child("vehicle"));
   c.gnss = ParseGnss(root.Child("gnss"));
   c.outages = ParseOutages(root.Child("outages"));

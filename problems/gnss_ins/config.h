@@ -11,6 +11,7 @@
 
 #include "core/types.h"
 #include "problems/gnss_ins/ins_vocabulary.h"
+#include "problems/ins/sources/odometer.h"
 
 namespace navtwin::gnss_ins {
 
@@ -105,6 +106,7 @@ struct GnssInsConfig {
   BaroConfig baro;
   ZuptConfig zupt;
   NhcConfig nhc;
+  ins::OdometerConfig odometer;
   VehicleConfig vehicle;
   GnssConfig gnss;
   OutageConfig outages;

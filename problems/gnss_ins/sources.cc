@@ -7,6 +7,7 @@
 #include "problems/ins/sources/gnss.h"
 #include "problems/ins/sources/mag.h"
 #include "problems/ins/sources/nhc.h"
+#include "problems/ins/sources/odometer.h"
 #include "problems/ins/sources/zupt.h"
 
 namespace navtwin::gnss_ins {
@@ -22,6 +23,7 @@ ins::AidingSources MakeSources(const Inputs& inputs, const GnssInsConfig& config
   sources.push_back(ins::MakeBaroSource(inputs.baro, config.baro, std::move(fix_times_s)));
   sources.push_back(ins::MakeZuptSource(config.zupt));
   if (config.nhc.enabled) sources.push_back(ins::MakeNhcSource(config.nhc, config.vehicle, config.zupt));
+  if (!config.odometer.file.empty()) sources.push_back(ins::MakeOdometerSource(config.odometer, config.vehicle));
   return sources;
 }
 

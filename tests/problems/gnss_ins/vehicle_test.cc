@@ -1,7 +1,8 @@
 // The vehicle constraints on the simulated MEMS car (preset mems-car-odometer, whose motion
 // obeys the non-holonomic constraint exactly at the IMU): through a 60 s GNSS outage the
 // NHC bounds the horizontal drift of the filter, the RTS smoother and the batch, and it
-// stays off while the car stands still.
+// stays off while the car stands still; the odometer bounds the along-track error too,
+// and filter, RTS and batch estimate its scale factor.
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -126,6 +127,35 @@ TEST_F(Car, NonHolonomicConstraintBoundsTheOutageDrift) {
   EXPECT_GT(used.used + used.rejected, 2000u);
   EXPECT_LT(used.used + used.rejected, 2600u);
   EXPECT_GT(batch_b.counts.at("nhc").used, 0u);
+}
+
+TEST_F(Car, OdometerBoundsTheAlongTrackDriftAndItsScaleFactorIsEstimated) {
+  GnssInsConfig nhc = Config();
+  nhc.nhc.enabled = true;
+  GnssInsConfig odo = nhc;
+  odo.odometer.file = *dir_ + "/odometer.csv";
+  const Inputs in = Load(nhc);
+  const FilterResult a = RunFilter(in, nhc, true, {}, nullptr);
+  const FilterResult b = RunFilter(in, odo, true, {}, nullptr);
+  const Solution batch = RunBatch(in, odo, *b.rts, nullptr);
+  const double filter_nhc = OutageDrift_m(a.filter, in), filter_odo = OutageDrift_m(b.filter, in);
+  std::cout << "outage drift [m] NHC / NHC + odometer: filter " << filter_nhc << " / " << filter_odo << ", RTS "
+            << OutageDrift_m(*a.rts, in) << " / " << OutageDrift_m(*b.rts, in) << ", batch "
+            << OutageDrift_m(batch, in) << "\n";
+  // The odometer measures the along-track speed that NHC leaves free.
+  EXPECT_LT(filter_odo, filter_nhc);
+  // The scale factor (5000 ppm in the preset) as the filter ends, the RTS and the batch
+  // estimate it: each within 3 of its own sigma, and each sigma below 1000 ppm.
+  const double truth = 5e-3;
+  for (const NavEpoch* e : {&b.filter.epochs.back(), &b.rts->epochs.front(), &batch.epochs.front()}) {
+    ASSERT_EQ(e->aux.size(), 1);
+    ASSERT_EQ(e->aux_std.size(), 1);
+    std::cout << "odometer scale " << e->aux[0] * 1e6 << " +- " << e->aux_std[0] * 1e6 << " ppm\n";
+    EXPECT_LT(std::abs(e->aux[0] - truth), 3.0 * e->aux_std[0]);
+    EXPECT_LT(e->aux_std[0], 1e-3);
+  }
+  EXPECT_GT(b.filter.counts.at("odometer").used, 2500u);  // 10 Hz over the 300 s lap
+  EXPECT_GT(batch.counts.at("odometer").used, 200u);      // at the batch's states
 }
 
 }  // namespace
