@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/allan.h"
 #include "core/calibration_file.h"
 #include "core/io/atomic_file.h"
@@ -18,10 +19,6 @@
 #include "core/io/open.h"
 #include "core/rotation.h"
 
-DECLARE_string(format);
-DECLARE_string(out);
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DEFINE_string(axis, "all", "allan: axis to analyse: gx, gy, gz (gyros), ax, ay, az (accelerometers) or all");
 
 namespace navtwin::app {

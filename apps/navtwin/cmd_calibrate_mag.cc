@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
@@ -29,12 +30,6 @@
 #include "problems/calibration/mag_calibration.h"
 #include "problems/calibration/mag_heading.h"
 
-DECLARE_string(format);  // main.cc
-DECLARE_string(mag);     // cmd_navigate.cc
-DECLARE_string(imu);     // cmd_ins.cc
-DECLARE_string(truth);   // cmd_ins.cc
-DECLARE_string(out);     // cmd_ins.cc
-DECLARE_string(method);  // cmd_inflight.cc
 DEFINE_double(declination_deg, 0.0,
               "calibrate-mag: magnetic declination (east positive) added to the magnetic heading, deg");
 DEFINE_double(field_uT, 0.0,

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
@@ -25,22 +26,6 @@
 #include "problems/inflight_alignment/run.h"
 #include "solvers/monte_carlo.h"
 
-DECLARE_string(format);
-DECLARE_string(imu);        // cmd_ins.cc
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
-DECLARE_string(truth);      // cmd_ins.cc
-DECLARE_string(init_from);  // cmd_ins.cc
-DECLARE_double(start_s);    // cmd_ins.cc (NaN: the first record of --init_from)
-DECLARE_string(gnss);       // cmd_navigate.cc
-DECLARE_string(baro);       // cmd_navigate.cc
-DECLARE_string(config);     // cmd_navigate.cc
-DECLARE_string(scenario);   // cmd_simulate.cc
-DECLARE_uint64(seed);       // cmd_simulate.cc
-DECLARE_int32(runs);        // cmd_level_mc.cc (default 10000 there; inflight-mc: 50 unless given)
-DECLARE_int32(threads);     // cmd_level_mc.cc
-DECLARE_string(errors_csv); // cmd_level_mc.cc
-DEFINE_string(method, "", "inflight-align: distance, kalman, batch or all; transfer-align: order1, order2, batch or all; transfer-align-ansfl: order2 or batch");
 DEFINE_string(track_csv, "",
               "inflight-align: write the heading track (t_s,path_length_km,yaw_deg,sigma_arcmin,error_arcmin) "
               "to this CSV; with --method all one file per method, the method's name before the extension");
@@ -63,12 +48,6 @@ constexpr int kDefaultMcRuns = 50;
 const std::vector<double> kAtKm = {10.0, 20.0, 50.0, 100.0};
 const std::vector<Method> kAllMethods = {Method::kDistance, Method::kKalman, Method::kBatch};
 
-/// True when the flag was not set (compared as text: is_default is false for a NaN default).
-bool IsDefault(const char* flag) {
-  const gflags::CommandLineFlagInfo info = gflags::GetCommandLineFlagInfoOrDie(flag);
-  return info.current_value == info.default_value;
-}
-
 int Usage(const std::string& command, const std::string& usage, const std::string& why) {
   std::cerr << "navtwin " << command << ": " << why << "\nusage: " << usage << "\n";
   return kExitUsage;
@@ -81,7 +60,7 @@ InflightConfig ConfigFromFlag() {
 
 /// Checks --outlier_fraction / --outlier_m; empty, or what is wrong.
 std::string CheckOutlierFlags(bool have_scenario) {
-  const bool fraction = !IsDefault("outlier_fraction"), size = !IsDefault("outlier_m");
+  const bool fraction = FlagGiven("outlier_fraction"), size = FlagGiven("outlier_m");
   if ((fraction || size) && !have_scenario) return "--outlier_fraction and --outlier_m go with --scenario";
   if (size && !fraction) return "--outlier_m needs --outlier_fraction";
   if (fraction && !(FLAGS_outlier_fraction >= 0.0 && FLAGS_outlier_fraction <= 1.0)) {
@@ -95,7 +74,7 @@ std::string CheckOutlierFlags(bool have_scenario) {
 sim::Scenario ScenarioFromFlags(const std::string& name) {
   sim::Scenario s = sim::LoadScenario(name);
   if (!s.gnss) throw std::invalid_argument("scenario " + name + " has no gnss section (in-flight alignment needs GPS)");
-  if (!IsDefault("outlier_fraction")) {
+  if (FlagGiven("outlier_fraction")) {
     s.gnss->outlier_probability = FLAGS_outlier_fraction;
     s.gnss->outlier_size_m = FLAGS_outlier_m;
   }
@@ -146,14 +125,14 @@ int RunInflightAlign(const std::vector<std::string>& args) {
   const bool scenario = !FLAGS_scenario.empty();
   if (scenario) {
     for (const char* flag : {"imu", "gnss", "baro", "init_from", "start_s", "truth", "calibration", "imu_temperature_degC"}) {
-      if (!IsDefault(flag)) return usage(std::string("--scenario simulates its own files: drop --") + flag);
+      if (FlagGiven(flag)) return usage(std::string("--scenario simulates its own files: drop --") + flag);
     }
   } else {
     if (FLAGS_imu.empty() || FLAGS_gnss.empty()) return usage("--imu and --gnss are required (or --scenario)");
     if (FLAGS_init_from.empty()) return usage("--init_from NAV is required: the INS's initial state");
-    if (!IsDefault("seed")) return usage("--seed goes with --scenario");
+    if (FlagGiven("seed")) return usage("--seed goes with --scenario");
     if (!std::isnan(FLAGS_start_s) && !std::isfinite(FLAGS_start_s)) return usage("--start_s must be a time, s");
-    if (FLAGS_calibration.empty() && !IsDefault("imu_temperature_degC")) {
+    if (FLAGS_calibration.empty() && FlagGiven("imu_temperature_degC")) {
       return usage("--imu_temperature_degC goes with --calibration");
     }
   }
@@ -385,7 +364,7 @@ void PrintMcJson(const std::string& scenario, const sim::Scenario& s, int runs, 
 int RunInflightMc(const std::vector<std::string>& args) {
   const auto usage = [](const std::string& why) { return Usage("inflight-mc", kMcUsage, why); };
   if (!args.empty()) return usage("unexpected argument '" + args[0] + "'");
-  const int runs = IsDefault("runs") ? kDefaultMcRuns : FLAGS_runs;
+  const int runs = FlagGiven("runs") ? FLAGS_runs : kDefaultMcRuns;
   if (runs < 1) return usage("--runs must be >= 1");
   if (FLAGS_threads < 0) return usage("--threads must be 0 (all cores) or positive");
   const std::string outlier_error = CheckOutlierFlags(true);

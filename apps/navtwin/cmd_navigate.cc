@@ -23,6 +23,7 @@
 
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/atomic_file.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
@@ -41,21 +42,6 @@
 #include "problems/gnss_ins/scoring.h"
 #include "problems/gnss_ins/sim_config.h"
 
-DECLARE_string(format);
-DECLARE_string(imu);
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
-DECLARE_string(out);
-DECLARE_string(truth);
-DECLARE_double(output_rate_hz);
-DECLARE_double(start_s);
-DECLARE_double(end_s);
-DECLARE_bool(demo);
-DECLARE_uint64(seed);
-DEFINE_string(gnss, "", "GNSS file: KF-GINS GNSS text, RTKLIB .pos or ULog");
-DEFINE_string(mag, "", "Magnetometer file (navtwin CSV, Xsens DOT raw, ULog); used when the configuration's mag.mode is not off");
-DEFINE_string(baro, "", "Barometer file (navtwin CSV, ULog); used when the configuration has baro.use");
-DEFINE_string(config, "", "YAML configuration (navigate, smooth: docs/gnss-ins.md; inflight-align: data/configs/inflight-mach07-south.yaml; transfer-align: data/configs/transfer-alignment-high-maneuver.yaml)");
 DEFINE_string(kfgins_config, "", "KF-GINS YAML configuration, taken unchanged (its imupath, gnsspath, outputpath are used when --imu, --gnss, --out are not given)");
 DEFINE_string(smoother, "", "navigate: rts = write the RTS-smoothed solution instead of the filter's");
 DEFINE_double(outage_start_s, NAN, "Injected GNSS outages for scoring: first outage start, s after the first IMU epoch");

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
@@ -23,10 +24,6 @@
 #include "problems/transfer_alignment/config.h"
 #include "problems/transfer_alignment/run.h"
 
-DECLARE_string(format);  // main.cc
-DECLARE_string(config);  // cmd_navigate.cc
-DECLARE_string(method);  // cmd_inflight.cc
-DEFINE_string(data, "", "transfer-align-ansfl: the ansfl-quadrotor folder (with StraightLine/ and Horizontal/)");
 DEFINE_string(csv, "", "transfer-align-ansfl: write one row per path and DOT to this CSV file");
 
 namespace navtwin::app {
