@@ -73,17 +73,6 @@ std::string Fixed(double x, int digits) {
 
 bool HasUncalibratedAxis(const MagCalibration& c) { return c.uncalibrated_axis.squaredNorm() > 0.0; }
 
-/// Population standard deviation of |m| over the record.
-double MagnitudeSpread(const std::vector<MagSample>& mag) {
-  double sum = 0.0, sum2 = 0.0;
-  for (const MagSample& s : mag) {
-    sum += s.m_b_uT.norm();
-    sum2 += s.m_b_uT.squaredNorm();
-  }
-  const double n = static_cast<double>(mag.size()), mean = sum / n;
-  return std::sqrt(std::max(0.0, sum2 / n - mean * mean));
-}
-
 void PrintText(const MagCalibration& c, const HeadingErrors& h, const std::string& attitude) {
   std::printf("magnetometer calibration (%s): %d samples, %d down-weighted, roll/pitch from %s\n", c.method.c_str(),
               c.samples, c.downweighted, attitude.c_str());
@@ -217,7 +206,7 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
     }
   } catch (const std::runtime_error& e) {  // data that cannot calibrate: the reason, with what was read
     std::cerr << "navtwin calibrate-mag: refused (" << mag.size() << " samples, |m| spread "
-              << Fixed(MagnitudeSpread(mag), 4) << " uT): " << e.what() << "\n";
+              << Fixed(calibration::FieldMagnitudeSpread_uT(mag), 4) << " uT): " << e.what() << "\n";
     return kExitFailure;
   }
   const calibration::HeadingErrors heading =
