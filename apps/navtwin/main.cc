@@ -143,6 +143,10 @@ int Main(int argc, char** argv) {
       PrintCommandHelp(*it);
       return kExitOk;
     }
+    if (std::strcmp(argv[i], "--version") == 0) {
+      PrintVersion();
+      return kExitOk;
+    }
   }
   std::vector<std::string> args;
   std::string error;
