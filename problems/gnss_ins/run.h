@@ -14,11 +14,11 @@
 #include <utility>
 #include <vector>
 
-#include "problems/gnss_ins/solution.h"  // first: config.h needs InsState
 #include "core/io/json_writer.h"
 #include "problems/gnss_ins/config.h"
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/scoring.h"
+#include "problems/gnss_ins/solution.h"
 
 namespace navtwin::gnss_ins {
 
