@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace navtwin {
 namespace {
@@ -130,6 +132,32 @@ AllanNoiseFit FitAllanNoise(const std::vector<AllanPoint>& curve) {
     fit.bias_instability_is_bound = true;
   }
   return fit;
+}
+
+ImuRateRecord ImuRates(const std::vector<ImuSample>& imu, const std::vector<int>& axes,
+                       double irregular_fraction) {
+  for (const int axis : axes) {
+    if (axis < 0 || axis > 5) throw std::invalid_argument("ImuRates: axis " + std::to_string(axis) + " is not 0..5");
+  }
+  const std::size_t need = 2 * AllanOptions().min_clusters;
+  if (imu.size() < need) {
+    throw std::invalid_argument("too few IMU samples for an Allan deviation (" + std::to_string(imu.size()) +
+                                ", need at least " + std::to_string(need) + ")");
+  }
+  ImuRateRecord r;
+  r.samples = imu.size();
+  r.duration_s = imu.back().t_s - (imu.front().t_s - imu.front().dt_s);
+  r.tau0_s = r.duration_s / static_cast<double>(r.samples);
+  for (const ImuSample& s : imu) {
+    r.irregular_intervals += std::abs(s.dt_s - r.tau0_s) > irregular_fraction * r.tau0_s;
+  }
+  for (const int axis : axes) {
+    std::vector<double> rate;
+    rate.reserve(imu.size());
+    for (const ImuSample& s : imu) rate.push_back((axis < 3 ? s.dtheta_b_rad : s.dv_b_mps)[axis % 3] / r.tau0_s);
+    r.rates.push_back(std::move(rate));
+  }
+  return r;
 }
 
 }  // namespace navtwin

@@ -12,6 +12,8 @@
 #include <limits>
 #include <vector>
 
+#include "core/types.h"
+
 namespace navtwin {
 
 /// One point of an Allan deviation curve.
@@ -63,5 +65,23 @@ struct AllanNoiseFit {
 AllanNoiseFit FitAllanNoise(const std::vector<AllanPoint>& curve);
 
 constexpr std::size_t kMinFitClusters = 9;
+
+/// IMU increments turned into rate series on one sampling interval, for the Allan deviation.
+struct ImuRateRecord {
+  std::size_t samples = 0;
+  /// The mean interval, span / samples: the rates increment / tau0 integrate to the recorded
+  /// angle and velocity even where the time tags jitter.
+  double tau0_s = 0.0;
+  double duration_s = 0.0;  ///< start of the first interval to the last epoch
+  std::size_t irregular_intervals = 0;  ///< dt_s further than irregular_fraction * tau0 from tau0
+  /// One series per requested axis: rad/s for a gyro axis, m/s^2 for an accelerometer axis.
+  std::vector<std::vector<double>> rates;
+};
+
+/// The rate series of `axes` (0, 1, 2: gyro x, y, z; 3, 4, 5: accelerometer x, y, z) of a
+/// record in time order. Throws std::invalid_argument for an axis outside 0..5 or fewer
+/// than 2 * AllanOptions().min_clusters samples (too few for one Allan point).
+ImuRateRecord ImuRates(const std::vector<ImuSample>& imu, const std::vector<int>& axes,
+                       double irregular_fraction = 0.1);
 
 }  // namespace navtwin

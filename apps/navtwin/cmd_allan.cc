@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/allan.h"
 #include "core/calibration_file.h"
 #include "core/io/atomic_file.h"
@@ -18,10 +19,6 @@
 #include "core/io/open.h"
 #include "core/rotation.h"
 
-DECLARE_string(format);
-DECLARE_string(out);
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
 DEFINE_string(axis, "all", "allan: axis to analyse: gx, gy, gz (gyros), ax, ay, az (accelerometers) or all");
 
 namespace navtwin::app {
@@ -55,48 +52,22 @@ struct AxisResult {
   AllanNoiseFit fit;              // SI
 };
 
-struct Record {
-  std::size_t samples = 0;
-  double tau0_s = 0.0;
-  double duration_s = 0.0;
-  std::size_t irregular = 0;  // intervals more than 10 % away from tau0
-  std::vector<std::vector<double>> increments;  // per selected axis
-};
-
-Record ReadRecord(const std::string& path, const std::vector<Axis>& axes) {
-  auto reader = OpenImu(path, FLAGS_calibration, FLAGS_imu_temperature_degC);
-  Record r;
-  r.increments.resize(axes.size());
-  std::vector<double> dts;
-  ImuSample s;
-  double t_start = 0.0, t_end = 0.0;
-  while (reader->Next(&s)) {
-    if (r.samples++ == 0) t_start = s.t_s - s.dt_s;
-    t_end = s.t_s;
-    dts.push_back(s.dt_s);
-    for (std::size_t i = 0; i < axes.size(); ++i) {
-      r.increments[i].push_back((axes[i].gyro ? s.dtheta_b_rad : s.dv_b_mps)[axes[i].index]);
-    }
+/// The IMU file's rate series of the chosen axes; a record too short names the file.
+ImuRateRecord ReadRates(const std::string& path, const std::vector<Axis>& axes) {
+  const std::vector<ImuSample> imu = ReadAll<ImuSample>(*OpenImu(path, FLAGS_calibration, FLAGS_imu_temperature_degC));
+  std::vector<int> indices;
+  for (const Axis& a : axes) indices.push_back(a.index + (a.gyro ? 0 : 3));
+  try {
+    return ImuRates(imu, indices, kIrregularFraction);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(path, 0, "", e.what());
   }
-  const std::size_t need = 2 * AllanOptions().min_clusters;
-  if (r.samples < need) {
-    throw InputError(path, 0, "", "too few IMU samples for an Allan deviation (" + std::to_string(r.samples) +
-                                      ", need at least " + std::to_string(need) + ")");
-  }
-  // The mean interval keeps the sum of the increments: the rates integrate to the
-  // recorded angle and velocity even where the time tags jitter.
-  r.duration_s = t_end - t_start;
-  r.tau0_s = r.duration_s / static_cast<double>(r.samples);
-  for (const double dt : dts) r.irregular += std::abs(dt - r.tau0_s) > kIrregularFraction * r.tau0_s;
-  return r;
 }
 
-std::vector<AxisResult> Analyse(const Record& r, const std::vector<Axis>& axes) {
+std::vector<AxisResult> Analyse(const ImuRateRecord& r, const std::vector<Axis>& axes) {
   std::vector<AxisResult> out;
   for (std::size_t i = 0; i < axes.size(); ++i) {
-    std::vector<double> rate(r.increments[i]);
-    for (double& y : rate) y /= r.tau0_s;
-    AxisResult a{axes[i], OverlappingAllanDeviation(rate, r.tau0_s), {}};
+    AxisResult a{axes[i], OverlappingAllanDeviation(r.rates[i], r.tau0_s), {}};
     a.fit = FitAllanNoise(a.curve);
     out.push_back(std::move(a));
   }
@@ -136,13 +107,13 @@ void PrintFitLine(const AxisResult& a) {
             << (g ? " deg/h/sqrt(h)" : " ug/sqrt(h)") << "\n";
 }
 
-void PrintText(const std::string& path, const Record& r, const std::vector<AxisResult>& results) {
+void PrintText(const std::string& path, const ImuRateRecord& r, const std::vector<AxisResult>& results) {
   char line[256];
   std::snprintf(line, sizeof line, "%s: %zu IMU samples, tau0 %.6f s (%.3f Hz), %.3f s\n", path.c_str(),
                 r.samples, r.tau0_s, 1.0 / r.tau0_s, r.duration_s);
   std::cout << line;
-  if (r.irregular > 0) {
-    std::cout << "note: " << r.irregular << " intervals differ from tau0 by more than 10 % (gaps or jitter); "
+  if (r.irregular_intervals > 0) {
+    std::cout << "note: " << r.irregular_intervals << " intervals differ from tau0 by more than 10 % (gaps or jitter); "
               << "the Allan deviation assumes uniform sampling\n";
   }
   std::cout << "Overlapping Allan deviation: gyros in deg/h, accelerometers in ug; clusters = "
@@ -168,14 +139,14 @@ void PrintText(const std::string& path, const Record& r, const std::vector<AxisR
   for (const AxisResult& a : results) PrintFitLine(a);
 }
 
-void PrintJson(const std::string& path, const Record& r, const std::vector<AxisResult>& results) {
+void PrintJson(const std::string& path, const ImuRateRecord& r, const std::vector<AxisResult>& results) {
   JsonWriter w(std::cout);
   w.BeginObject()
       .Field("path", path)
       .Field("samples", r.samples)
       .Field("tau0_s", r.tau0_s)
       .Field("duration_s", r.duration_s)
-      .Field("irregular_intervals", r.irregular);
+      .Field("irregular_intervals", r.irregular_intervals);
   w.Key("axes").BeginArray();
   for (const AxisResult& a : results) {
     const bool g = a.axis.gyro;
@@ -217,7 +188,7 @@ int RunAllan(const std::vector<std::string>& args) {
   if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
     return Usage("--imu_temperature_degC goes with --calibration");
   }
-  const Record record = ReadRecord(args[0], axes);
+  const ImuRateRecord record = ReadRates(args[0], axes);
   const std::vector<AxisResult> results = Analyse(record, axes);
   if (!FLAGS_out.empty()) WriteCsv(FLAGS_out, results);
   if (FLAGS_format == "json") {

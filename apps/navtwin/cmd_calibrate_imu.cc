@@ -11,12 +11,10 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
 #include "problems/calibration/imu_calibration.h"
 
-DECLARE_string(format);
-DECLARE_string(data);
-DECLARE_string(out);
 DEFINE_string(rig, "", "calibrate-imu: multiposition, pendulum or temperature (what --data records)");
 
 namespace navtwin::app {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
@@ -29,12 +30,6 @@
 #include "problems/calibration/mag_calibration.h"
 #include "problems/calibration/mag_heading.h"
 
-DECLARE_string(format);  // main.cc
-DECLARE_string(mag);     // cmd_navigate.cc
-DECLARE_string(imu);     // cmd_ins.cc
-DECLARE_string(truth);   // cmd_ins.cc
-DECLARE_string(out);     // cmd_ins.cc
-DECLARE_string(method);  // cmd_inflight.cc
 DEFINE_double(declination_deg, 0.0,
               "calibrate-mag: magnetic declination (east positive) added to the magnetic heading, deg");
 DEFINE_double(field_uT, 0.0,
@@ -77,17 +72,6 @@ std::string Fixed(double x, int digits) {
 }
 
 bool HasUncalibratedAxis(const MagCalibration& c) { return c.uncalibrated_axis.squaredNorm() > 0.0; }
-
-/// Population standard deviation of |m| over the record.
-double MagnitudeSpread(const std::vector<MagSample>& mag) {
-  double sum = 0.0, sum2 = 0.0;
-  for (const MagSample& s : mag) {
-    sum += s.m_b_uT.norm();
-    sum2 += s.m_b_uT.squaredNorm();
-  }
-  const double n = static_cast<double>(mag.size()), mean = sum / n;
-  return std::sqrt(std::max(0.0, sum2 / n - mean * mean));
-}
 
 void PrintText(const MagCalibration& c, const HeadingErrors& h, const std::string& attitude) {
   std::printf("magnetometer calibration (%s): %d samples, %d down-weighted, roll/pitch from %s\n", c.method.c_str(),
@@ -160,6 +144,29 @@ void PrintJson(const MagCalibration& c, const HeadingErrors& h, const std::strin
   std::cout << "\n";
 }
 
+/// The fit of --method; the bidirectional one over the samples with a roll and pitch.
+MagCalibration FitByMethod(const std::vector<MagSample>& mag,
+                           const std::vector<std::optional<Eigen::Vector2d>>& roll_pitch) {
+  if (FLAGS_method == "planar") return calibration::FitPlanar(mag);
+  if (FLAGS_method == "ellipsoid") {
+    calibration::EllipsoidFitOptions options;
+    options.field_uT = FLAGS_field_uT;
+    return calibration::FitEllipsoid(mag, options);
+  }
+  std::vector<MagSample> used;
+  std::vector<Eigen::Vector2d> used_rp;
+  for (std::size_t i = 0; i < mag.size(); ++i) {
+    if (!roll_pitch[i]) continue;
+    used.push_back(mag[i]);
+    used_rp.push_back(*roll_pitch[i]);
+  }
+  if (used.size() < mag.size()) {
+    std::cerr << "calibrate-mag: " << mag.size() - used.size() << " samples outside the attitude record ("
+              << (FLAGS_truth.empty() ? FLAGS_imu : FLAGS_truth) << ") are left out\n";
+  }
+  return calibration::FitBidirectional(used, used_rp);
+}
+
 int RunCalibrateMag(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args.front() + "'");
   if (FLAGS_mag.empty()) return Usage("--mag FILE is required");
@@ -175,58 +182,28 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
   if (mag.empty()) throw InputError(FLAGS_mag, 0, "t_s", "no magnetometer samples");
 
   // Attitude per sample: roll, pitch (and yaw from the truth).
-  std::vector<std::optional<Eigen::Vector3d>> truth(mag.size());
-  std::vector<std::optional<Eigen::Vector2d>> roll_pitch(mag.size());
-  std::string attitude = "level (assumed)";
+  calibration::MagSampleAttitudes attitudes;
   if (!FLAGS_truth.empty()) {
-    attitude = "truth";
-    const std::vector<NavState> nav = ReadAll<NavState>(*OpenNav(FLAGS_truth));
-    for (std::size_t i = 0; i < mag.size(); ++i) {
-      truth[i] = calibration::EulerAt(nav, mag[i].t_s);
-      if (truth[i]) roll_pitch[i] = truth[i]->head<2>();
-    }
+    attitudes = calibration::AttitudesFromNav(mag, ReadAll<NavState>(*OpenNav(FLAGS_truth)));
     if (!FLAGS_imu.empty()) std::cerr << "calibrate-mag: --truth gives roll and pitch; --imu is not used\n";
   } else if (!FLAGS_imu.empty()) {
-    attitude = "imu accelerometer";
-    const calibration::AccelerometerLevel level(ReadAll<ImuSample>(*OpenImu(FLAGS_imu)),
-                                                 0.5 * calibration::MedianInterval_s(mag));
-    for (std::size_t i = 0; i < mag.size(); ++i) roll_pitch[i] = level.At(mag[i].t_s);
+    attitudes = calibration::AttitudesFromAccelerometer(mag, ReadAll<ImuSample>(*OpenImu(FLAGS_imu)));
   } else {
-    for (auto& rp : roll_pitch) rp = Eigen::Vector2d::Zero();
+    attitudes = calibration::LevelAttitudes(mag);
     if (two_axis) std::cerr << "calibrate-mag: no --truth or --imu: every sample is taken as level\n";
   }
+  const std::string& attitude = attitudes.source;
 
   MagCalibration c;
   try {
-    if (two_axis) {
-      // Only the samples with an attitude enter the tilt-gated fit.
-      std::vector<MagSample> used;
-      std::vector<Eigen::Vector2d> used_rp;
-      for (std::size_t i = 0; i < mag.size(); ++i) {
-        if (!roll_pitch[i]) continue;
-        used.push_back(mag[i]);
-        used_rp.push_back(*roll_pitch[i]);
-      }
-      if (used.size() < mag.size()) {
-        std::cerr << "calibrate-mag: " << mag.size() - used.size()
-                  << " samples outside the attitude record (" << (FLAGS_truth.empty() ? FLAGS_imu : FLAGS_truth)
-                  << ") are left out\n";
-      }
-      c = calibration::FitBidirectional(used, used_rp);
-    } else if (FLAGS_method == "planar") {
-      c = calibration::FitPlanar(mag);
-    } else {
-      calibration::EllipsoidFitOptions options;
-      options.field_uT = FLAGS_field_uT;
-      c = calibration::FitEllipsoid(mag, options);
-    }
+    c = FitByMethod(mag, attitudes.roll_pitch_rad);
   } catch (const std::runtime_error& e) {  // data that cannot calibrate: the reason, with what was read
     std::cerr << "navtwin calibrate-mag: refused (" << mag.size() << " samples, |m| spread "
-              << Fixed(MagnitudeSpread(mag), 4) << " uT): " << e.what() << "\n";
+              << Fixed(calibration::FieldMagnitudeSpread_uT(mag), 4) << " uT): " << e.what() << "\n";
     return kExitFailure;
   }
   const calibration::HeadingErrors heading =
-      calibration::MagHeadingErrors(mag, truth, c, two_axis, FLAGS_declination_deg * kDegToRad);
+      calibration::MagHeadingErrors(mag, attitudes.euler_rad, c, two_axis, FLAGS_declination_deg * kDegToRad);
   if (!FLAGS_truth.empty() && heading.samples == 0) {
     std::cerr << "calibrate-mag: warning: no magnetometer sample inside " << FLAGS_truth
               << " (with |pitch| <= 80 deg): heading errors are n/a\n";

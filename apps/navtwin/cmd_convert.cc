@@ -6,13 +6,12 @@
 #include <iostream>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/csv_imu.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
 #include "core/io/open.h"
 
-DECLARE_string(format);
-DECLARE_string(out);
 DEFINE_string(in, "", "Input file (any format `navtwin info` knows)");
 DEFINE_string(what, "", "Stream to convert: imu, gnss or nav (default: the file's main stream)");
 DEFINE_string(to, "", "Output format: kfgins or csv (default: csv for a .csv output, else kfgins)");

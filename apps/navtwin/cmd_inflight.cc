@@ -5,8 +5,6 @@
 // methods over seeds of a scenario and prints the statistics of the errors.
 #include <gflags/gflags.h>
 
-#include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -16,31 +14,15 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
-#include "core/io/atomic_file.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "problems/inflight_alignment/config.h"
 #include "problems/inflight_alignment/inputs.h"
+#include "problems/inflight_alignment/monte_carlo.h"
 #include "problems/inflight_alignment/run.h"
-#include "solvers/monte_carlo.h"
 
-DECLARE_string(format);
-DECLARE_string(imu);        // cmd_ins.cc
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
-DECLARE_string(truth);      // cmd_ins.cc
-DECLARE_string(init_from);  // cmd_ins.cc
-DECLARE_double(start_s);    // cmd_ins.cc (NaN: the first record of --init_from)
-DECLARE_string(gnss);       // cmd_navigate.cc
-DECLARE_string(baro);       // cmd_navigate.cc
-DECLARE_string(config);     // cmd_navigate.cc
-DECLARE_string(scenario);   // cmd_simulate.cc
-DECLARE_uint64(seed);       // cmd_simulate.cc
-DECLARE_int32(runs);        // cmd_level_mc.cc (default 10000 there; inflight-mc: 50 unless given)
-DECLARE_int32(threads);     // cmd_level_mc.cc
-DECLARE_string(errors_csv); // cmd_level_mc.cc
-DEFINE_string(method, "", "inflight-align: distance, kalman, batch or all; transfer-align: order1, order2, batch or all; transfer-align-ansfl: order2 or batch");
 DEFINE_string(track_csv, "",
               "inflight-align: write the heading track (t_s,path_length_km,yaw_deg,sigma_arcmin,error_arcmin) "
               "to this CSV; with --method all one file per method, the method's name before the extension");
@@ -63,12 +45,6 @@ constexpr int kDefaultMcRuns = 50;
 const std::vector<double> kAtKm = {10.0, 20.0, 50.0, 100.0};
 const std::vector<Method> kAllMethods = {Method::kDistance, Method::kKalman, Method::kBatch};
 
-/// True when the flag was not set (compared as text: is_default is false for a NaN default).
-bool IsDefault(const char* flag) {
-  const gflags::CommandLineFlagInfo info = gflags::GetCommandLineFlagInfoOrDie(flag);
-  return info.current_value == info.default_value;
-}
-
 int Usage(const std::string& command, const std::string& usage, const std::string& why) {
   std::cerr << "navtwin " << command << ": " << why << "\nusage: " << usage << "\n";
   return kExitUsage;
@@ -81,7 +57,7 @@ InflightConfig ConfigFromFlag() {
 
 /// Checks --outlier_fraction / --outlier_m; empty, or what is wrong.
 std::string CheckOutlierFlags(bool have_scenario) {
-  const bool fraction = !IsDefault("outlier_fraction"), size = !IsDefault("outlier_m");
+  const bool fraction = FlagGiven("outlier_fraction"), size = FlagGiven("outlier_m");
   if ((fraction || size) && !have_scenario) return "--outlier_fraction and --outlier_m go with --scenario";
   if (size && !fraction) return "--outlier_m needs --outlier_fraction";
   if (fraction && !(FLAGS_outlier_fraction >= 0.0 && FLAGS_outlier_fraction <= 1.0)) {
@@ -95,7 +71,7 @@ std::string CheckOutlierFlags(bool have_scenario) {
 sim::Scenario ScenarioFromFlags(const std::string& name) {
   sim::Scenario s = sim::LoadScenario(name);
   if (!s.gnss) throw std::invalid_argument("scenario " + name + " has no gnss section (in-flight alignment needs GPS)");
-  if (!IsDefault("outlier_fraction")) {
+  if (FlagGiven("outlier_fraction")) {
     s.gnss->outlier_probability = FLAGS_outlier_fraction;
     s.gnss->outlier_size_m = FLAGS_outlier_m;
   }
@@ -146,14 +122,14 @@ int RunInflightAlign(const std::vector<std::string>& args) {
   const bool scenario = !FLAGS_scenario.empty();
   if (scenario) {
     for (const char* flag : {"imu", "gnss", "baro", "init_from", "start_s", "truth", "calibration", "imu_temperature_degC"}) {
-      if (!IsDefault(flag)) return usage(std::string("--scenario simulates its own files: drop --") + flag);
+      if (FlagGiven(flag)) return usage(std::string("--scenario simulates its own files: drop --") + flag);
     }
   } else {
     if (FLAGS_imu.empty() || FLAGS_gnss.empty()) return usage("--imu and --gnss are required (or --scenario)");
     if (FLAGS_init_from.empty()) return usage("--init_from NAV is required: the INS's initial state");
-    if (!IsDefault("seed")) return usage("--seed goes with --scenario");
+    if (FlagGiven("seed")) return usage("--seed goes with --scenario");
     if (!std::isnan(FLAGS_start_s) && !std::isfinite(FLAGS_start_s)) return usage("--start_s must be a time, s");
-    if (FLAGS_calibration.empty() && !IsDefault("imu_temperature_degC")) {
+    if (FLAGS_calibration.empty() && FlagGiven("imu_temperature_degC")) {
       return usage("--imu_temperature_degC goes with --calibration");
     }
   }
@@ -224,99 +200,13 @@ const char* kMcUsage =
     "  the mean, sigma (sample standard deviation) and RMS over the runs of the heading error at 10, 20,\n"
     "  50, 100 km and at the end (arcmin), and the mean reported final sigma. --runs defaults to 50 here.";
 
-/// One method's numbers of one run (NaN where the method failed or the distance was not reached).
-struct RunNumbers {
-  std::array<double, 4> at_km_arcmin{};
-  double final_arcmin = NAN;
-  double sigma_arcmin = NAN;
-  double run_time_s = NAN;
-  std::string failure;  ///< empty unless the method threw
-};
+using inflight::McMethodStats;
+using inflight::Moments;
 
-struct Moments {
-  double mean = NAN, sigma = NAN, rms = NAN;
-  int count = 0;  ///< runs with a finite value
-};
+/// Moments in the printed unit: mean, sigma and RMS times `scale`.
+Moments Scaled(const Moments& m, double scale) { return {m.mean * scale, m.sigma * scale, m.rms * scale, m.count}; }
 
-/// Mean, sample standard deviation (n - 1) and RMS of the finite values, in run order.
-Moments MomentsOf(const std::vector<double>& values) {
-  Moments m;
-  double sum = 0.0, sum2 = 0.0;
-  for (const double v : values) {
-    if (!std::isfinite(v)) continue;
-    ++m.count;
-    sum += v;
-    sum2 += v * v;
-  }
-  if (m.count == 0) return m;
-  m.mean = sum / m.count;
-  m.rms = std::sqrt(sum2 / m.count);
-  if (m.count > 1) {
-    double dev2 = 0.0;
-    for (const double v : values) {
-      if (std::isfinite(v)) dev2 += (v - m.mean) * (v - m.mean);
-    }
-    m.sigma = std::sqrt(dev2 / (m.count - 1));
-  }
-  return m;
-}
-
-struct MethodStats {
-  Method method;
-  std::array<Moments, 4> at_km;
-  Moments final_error;
-  Moments sigma;  ///< of the reported final sigma (mean used)
-  Moments run_time;
-  int failures = 0;
-  std::string first_failure;
-};
-
-MethodStats StatsOf(Method method, int index, const std::vector<std::array<RunNumbers, 3>>& runs) {
-  MethodStats s;
-  s.method = method;
-  const auto column = [&](auto get) {
-    std::vector<double> v;
-    for (const auto& run : runs) v.push_back(get(run[index]));
-    return MomentsOf(v);
-  };
-  for (int k = 0; k < 4; ++k) s.at_km[k] = column([k](const RunNumbers& r) { return r.at_km_arcmin[k]; });
-  s.final_error = column([](const RunNumbers& r) { return r.final_arcmin; });
-  s.sigma = column([](const RunNumbers& r) { return r.sigma_arcmin; });
-  s.run_time = column([](const RunNumbers& r) { return r.run_time_s; });
-  for (const auto& run : runs) {
-    if (run[index].failure.empty()) continue;
-    if (s.failures++ == 0) s.first_failure = run[index].failure;
-  }
-  return s;
-}
-
-RunNumbers NumbersOf(const MethodResult& r) {
-  RunNumbers n;
-  for (int k = 0; k < 4; ++k) n.at_km_arcmin[k] = r.error_at_km_rad[k] * kRadToArcmin;
-  n.final_arcmin = r.final_error_rad * kRadToArcmin;
-  n.sigma_arcmin = r.final_sigma_rad * kRadToArcmin;
-  n.run_time_s = r.run_time_s;
-  return n;
-}
-
-void WriteMcErrorsCsv(const std::string& path, std::uint64_t seed,
-                      const std::vector<std::array<RunNumbers, 3>>& runs) {
-  AtomicFile f(path);
-  std::ostream& o = f.stream();
-  o << "run,seed,method,error_10km_arcmin,error_20km_arcmin,error_50km_arcmin,error_100km_arcmin,"
-       "final_error_arcmin,final_sigma_arcmin,run_time_s\n";
-  for (std::size_t run = 0; run < runs.size(); ++run) {
-    for (int m = 0; m < 3; ++m) {
-      const RunNumbers& n = runs[run][m];
-      o << run << "," << seed + run << "," << inflight::MethodName(kAllMethods[m]);
-      for (const double x : n.at_km_arcmin) o << "," << x;
-      o << "," << n.final_arcmin << "," << n.sigma_arcmin << "," << n.run_time_s << "\n";
-    }
-  }
-  f.Commit();
-}
-
-void PrintMcText(const std::string& header, const std::vector<MethodStats>& stats, double wall_s) {
+void PrintMcText(const std::string& header, const std::vector<McMethodStats>& stats, double wall_s) {
   std::cout << header << "\n";
   char line[256];
   std::snprintf(line, sizeof line, "%-9s %-9s %10s %10s %10s %6s\n", "method", "error at", "mean", "sigma", "rms",
@@ -330,16 +220,17 @@ void PrintMcText(const std::string& header, const std::vector<MethodStats>& stat
     std::snprintf(buf, sizeof buf, "%.3f", x);
     return std::string(buf);
   };
-  for (const MethodStats& s : stats) {
+  for (const McMethodStats& s : stats) {
     for (int k = 0; k <= 4; ++k) {
-      const Moments& m = k < 4 ? s.at_km[k] : s.final_error;
+      const Moments m = Scaled(k < 4 ? s.error_at_km_rad[k] : s.final_error_rad, kRadToArcmin);
       const std::string label = k < 4 ? std::to_string(static_cast<int>(kAtKm[k])) + " km" : "final";
       std::snprintf(line, sizeof line, "%-9s %-9s %10s %10s %10s %6d\n", inflight::MethodName(s.method),
                     label.c_str(), cell(m.mean).c_str(), cell(m.sigma).c_str(), cell(m.rms).c_str(), m.count);
       std::cout << line;
     }
     std::snprintf(line, sizeof line, "%-9s mean reported final sigma %s arcmin, mean run time %s s%s\n",
-                  inflight::MethodName(s.method), cell(s.sigma.mean).c_str(), cell(s.run_time.mean).c_str(),
+                  inflight::MethodName(s.method), cell(s.final_sigma_rad.mean * kRadToArcmin).c_str(),
+                  cell(s.run_time_s.mean).c_str(),
                   s.failures ? (", " + std::to_string(s.failures) + " runs failed").c_str() : "");
     std::cout << line;
     if (s.failures) std::cout << "  first failure: " << s.first_failure << "\n";
@@ -349,7 +240,7 @@ void PrintMcText(const std::string& header, const std::vector<MethodStats>& stat
 }
 
 void PrintMcJson(const std::string& scenario, const sim::Scenario& s, int runs, std::uint64_t seed,
-                 const std::vector<MethodStats>& stats, double wall_s) {
+                 const std::vector<McMethodStats>& stats, double wall_s) {
   JsonWriter w(std::cout);
   w.BeginObject()
       .Field("scenario", scenario)
@@ -362,18 +253,18 @@ void PrintMcJson(const std::string& scenario, const sim::Scenario& s, int runs, 
     w.BeginObject().Field("mean", m.mean).Field("sigma", m.sigma).Field("rms", m.rms).Field("runs", m.count).EndObject();
   };
   w.Key("methods").BeginObject();
-  for (const MethodStats& st : stats) {
+  for (const McMethodStats& st : stats) {
     w.Key(inflight::MethodName(st.method)).BeginObject();
     w.Key("final_heading_error_arcmin");
-    moments(st.final_error);
+    moments(Scaled(st.final_error_rad, kRadToArcmin));
     w.Key("heading_error_arcmin_at_km").BeginObject();
     for (int k = 0; k < 4; ++k) {
       w.Key(std::to_string(static_cast<int>(kAtKm[k])));
-      moments(st.at_km[k]);
+      moments(Scaled(st.error_at_km_rad[k], kRadToArcmin));
     }
     w.EndObject();
-    w.Field("mean_heading_sigma_arcmin", st.sigma.mean)
-        .Field("mean_run_time_s", st.run_time.mean)
+    w.Field("mean_heading_sigma_arcmin", st.final_sigma_rad.mean * kRadToArcmin)
+        .Field("mean_run_time_s", st.run_time_s.mean)
         .Field("failures", st.failures)
         .Field("first_failure", st.first_failure)
         .EndObject();
@@ -385,7 +276,7 @@ void PrintMcJson(const std::string& scenario, const sim::Scenario& s, int runs, 
 int RunInflightMc(const std::vector<std::string>& args) {
   const auto usage = [](const std::string& why) { return Usage("inflight-mc", kMcUsage, why); };
   if (!args.empty()) return usage("unexpected argument '" + args[0] + "'");
-  const int runs = IsDefault("runs") ? kDefaultMcRuns : FLAGS_runs;
+  const int runs = FlagGiven("runs") ? FLAGS_runs : kDefaultMcRuns;
   if (runs < 1) return usage("--runs must be >= 1");
   if (FLAGS_threads < 0) return usage("--threads must be 0 (all cores) or positive");
   const std::string outlier_error = CheckOutlierFlags(true);
@@ -393,37 +284,20 @@ int RunInflightMc(const std::vector<std::string>& args) {
   const std::string scenario_name = FLAGS_scenario.empty() ? kDefaultMcScenario : FLAGS_scenario;
   const InflightConfig config = ConfigFromFlag();
   const sim::Scenario scenario = ScenarioFromFlags(scenario_name);
-  const std::uint64_t seed = FLAGS_seed;
-
+  inflight::McOptions options;
+  options.runs = runs;
+  options.seed = FLAGS_seed;
+  options.threads = FLAGS_threads;
+  options.methods = kAllMethods;
+  options.at_km = kAtKm;
+  options.progress = [](int done, int total) { std::fprintf(stderr, "inflight-mc: %d/%d runs\n", done, total); };
+  const std::uint64_t seed = options.seed;
   std::cerr << "inflight-mc: " << runs << " runs of " << scenario.name << ", seeds " << seed << ".."
             << seed + runs - 1 << ", " << OutlierText(scenario) << "\n";
-  const auto start = std::chrono::steady_clock::now();
-  // Each run writes only its own slot; statistics are taken in run order afterwards, so
-  // the output does not depend on the thread count.
-  std::vector<std::array<RunNumbers, 3>> slots(runs);
-  RunParallel(
-      runs, FLAGS_threads,
-      [&](int run, int /*worker*/) {
-        const InflightInputs inputs = inflight::SimulateInflightInputs(scenario, seed + run);
-        for (int m = 0; m < 3; ++m) {
-          try {
-            slots[run][m] = NumbersOf(inflight::RunMethod(inputs, config, kAllMethods[m], kAtKm));
-          } catch (const std::exception& e) {
-            // A method failing on one seed is a result (counted, first reason printed), not
-            // the end of the experiment.
-            slots[run][m] = RunNumbers();
-            slots[run][m].at_km_arcmin.fill(NAN);
-            slots[run][m].failure = "seed " + std::to_string(seed + run) + ": " + e.what();
-          }
-        }
-      },
-      [](int done, int total) { std::fprintf(stderr, "inflight-mc: %d/%d runs\n", done, total); });
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  std::vector<MethodStats> stats;
-  for (int m = 0; m < 3; ++m) stats.push_back(StatsOf(kAllMethods[m], m, slots));
-  if (!FLAGS_errors_csv.empty()) WriteMcErrorsCsv(FLAGS_errors_csv, seed, slots);
+  const inflight::McResult mc = inflight::RunInflightMonteCarlo(scenario, config, options);
+  const std::vector<McMethodStats>& stats = mc.stats;
+  const double wall_s = mc.wall_time_s;
+  if (!FLAGS_errors_csv.empty()) inflight::WriteMcErrorsCsv(mc, FLAGS_errors_csv);
   if (FLAGS_format == "json") {
     PrintMcJson(scenario_name, scenario, runs, seed, stats, wall_s);
   } else {
@@ -431,7 +305,7 @@ int RunInflightMc(const std::vector<std::string>& args) {
     std::snprintf(header, sizeof header, "inflight-mc: %d runs of %s, seeds %llu..%llu, %s, %d thread%s", runs,
                   scenario.name.c_str(), static_cast<unsigned long long>(seed),
                   static_cast<unsigned long long>(seed + runs - 1), OutlierText(scenario).c_str(),
-                  MonteCarloWorkers(runs, FLAGS_threads), MonteCarloWorkers(runs, FLAGS_threads) == 1 ? "" : "s");
+                  mc.workers, mc.workers == 1 ? "" : "s");
     PrintMcText(header, stats, wall_s);
   }
   return kExitOk;

@@ -7,10 +7,10 @@
 #include <iostream>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/json_writer.h"
 #include "core/io/open.h"
 
-DECLARE_string(format);
 
 namespace navtwin::app {
 namespace {

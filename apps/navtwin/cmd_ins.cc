@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
@@ -20,17 +21,6 @@
 #include "problems/ins/demo_flight.h"
 #include "problems/ins/pure_ins.h"
 
-DECLARE_string(format);
-DEFINE_string(imu, "", "IMU file (any format `navtwin info` knows)");
-DEFINE_string(calibration, "",
-              "Calibration file (docs/calibration-file.md) applied as the IMU (its imu section) and the "
-              "magnetometer (its mag section) are read");
-DEFINE_double(imu_temperature_degC, NAN,
-              "IMU temperature at which the calibration's temperature terms are evaluated, degC "
-              "(default: the calibration file's reference temperature)");
-DEFINE_string(out, "", "ins: output folder (created if missing) for nav.nav; convert: output file");
-DEFINE_string(truth, "", "Reference trajectory (navigation file) to compute errors against");
-DEFINE_string(init_from, "", "Navigation file whose record at --start_s sets the initial state");
 DEFINE_double(init_lat_deg, NAN, "Initial latitude, deg");
 DEFINE_double(init_lon_deg, NAN, "Initial longitude, deg");
 DEFINE_double(init_h_m, 0.0, "Initial ellipsoidal height, m");
@@ -40,13 +30,7 @@ DEFINE_double(init_vd_mps, 0.0, "Initial down velocity, m/s");
 DEFINE_double(init_roll_deg, 0.0, "Initial roll, deg");
 DEFINE_double(init_pitch_deg, 0.0, "Initial pitch, deg");
 DEFINE_double(init_yaw_deg, NAN, "Initial yaw (heading), deg");
-DEFINE_double(start_s, NAN,
-              "Start time, s (ins, navigate: default the initial record, or the first IMU interval; "
-              "level: seconds after the first IMU sample, default 0)");
-DEFINE_double(end_s, INFINITY, "Stop after this time, s");
-DEFINE_double(output_rate_hz, 0.0, "Solution output rate, Hz (0: every IMU epoch)");
 DEFINE_double(hold_height_m, NAN, "Hold the height at this value (damps the unstable vertical channel)");
-DEFINE_bool(demo, false, "Simulate a built-in demo into --out and run on it with truth (ins: a 10-min flight; navigate, smooth: mems-gps-mag-maneuver)");
 DEFINE_double(demo_rate_hz, 100.0, "IMU rate of the demo flight, Hz");
 DEFINE_double(demo_duration_s, 600.0, "Length of the demo flight, s");
 

@@ -13,24 +13,12 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
 #include "problems/leveling/leveling.h"
 #include "problems/leveling/window.h"
 
-DECLARE_string(format);
-DECLARE_string(imu);
-DECLARE_double(start_s);
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
-DEFINE_double(window_s, 0.2, "level, level-mc: leveling window length, s");
-DEFINE_double(noise_mg, 50.0,
-              "Accelerometer white noise, 1 sigma per axis, mg (level-mc: simulated; level: assumed by the "
-              "methods, estimated from the data when not given)");
-DEFINE_string(vib_axes, "x",
-              "Body axes with vibration, any of x, y, z (level-mc: simulated; level: modelled by the batch, "
-              "all three when not given)");
-DEFINE_int32(vib_tones, 1, "Vibration tones per axis: the fundamental and harmonics up to this multiple");
 DEFINE_bool(allow_motion, false, "level: level even when the window shows motion (rotation or |f| != g)");
 
 namespace navtwin::app {
@@ -56,15 +44,13 @@ bool ParseAxes(const std::string& text, std::array<bool, 3>* axes) {
   return (*axes)[0] || (*axes)[1] || (*axes)[2];
 }
 
-bool IsDefault(const char* flag) { return gflags::GetCommandLineFlagInfoOrDie(flag).is_default; }
-
 /// The leveling options from the flags; an empty string, or why the flags are bad.
 std::string OptionsFromFlags(leveling::LevelingOptions* options) {
-  if (!IsDefault("noise_mg")) {
+  if (FlagGiven("noise_mg")) {
     if (!(FLAGS_noise_mg > 0.0) || !std::isfinite(FLAGS_noise_mg)) return "--noise_mg must be a number > 0";
     options->accel_noise_mps2 = FLAGS_noise_mg * kMilliG_mps2;
   }
-  if (!IsDefault("vib_axes") && !ParseAxes(FLAGS_vib_axes, &options->vib_axes)) {
+  if (FlagGiven("vib_axes") && !ParseAxes(FLAGS_vib_axes, &options->vib_axes)) {
     return "--vib_axes must name some of x, y, z (e.g. x or xz), got '" + FLAGS_vib_axes + "'";
   }
   if (FLAGS_vib_tones < 1) return "--vib_tones must be >= 1";

@@ -15,26 +15,18 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "problems/leveling/monte_carlo.h"
 
-DECLARE_string(format);
-DECLARE_uint64(seed);
 // Shared with `navtwin level` (defined in cmd_level.cc): window_s 0.2, noise_mg 50,
 // vib_axes "x", vib_tones 1 by default, the seed's values.
-DECLARE_double(window_s);
-DECLARE_double(noise_mg);
-DECLARE_string(vib_axes);
-DECLARE_int32(vib_tones);
-DEFINE_int32(runs, 10000, "level-mc, inflight-mc: number of Monte Carlo runs (level-mc default 10000, inflight-mc 50)");
 DEFINE_double(rate_hz, 600.0, "level-mc: accelerometer sample rate, Hz");
 DEFINE_string(vib_freq_hz, "22:24", "level-mc: vibration fundamental, LO:HI (drawn uniformly per run) or one value, Hz");
 DEFINE_double(vib_amp_g, 1.0, "level-mc: 1 sigma of the zero-mean normal vibration amplitude, g");
 DEFINE_double(true_roll_deg, 0.0, "level-mc: true roll, deg");
 DEFINE_double(true_pitch_deg, 0.0, "level-mc: true pitch, deg");
-DEFINE_int32(threads, 2, "level-mc, inflight-mc: worker threads (0: all cores); the results do not depend on it");
-DEFINE_string(errors_csv, "", "level-mc, inflight-mc: write every run's errors of every method to this CSV");
 DEFINE_bool(batch_covariance, false, "level-mc: batch standard deviations from ceres::Covariance in every run (slower)");
 
 namespace navtwin::app {

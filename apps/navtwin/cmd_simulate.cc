@@ -8,14 +8,11 @@
 #include <iostream>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/json_writer.h"
 #include "core/sim/presets.h"
 #include "core/sim/simulator.h"
 
-DECLARE_string(format);
-DECLARE_string(out);
-DEFINE_string(scenario, "", "Scenario: a preset name (see --list_presets) or a YAML file");
-DEFINE_uint64(seed, 1, "Random seed: the same seed gives the same files, byte for byte");
 DEFINE_bool(perfect, false, "Turn every sensor error off (truth-consistent data)");
 DEFINE_bool(list_presets, false, "List the preset scenarios and exit");
 DEFINE_bool(print_scenario, false, "Print the YAML of --scenario (a preset) and exit");

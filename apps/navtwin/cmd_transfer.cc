@@ -16,21 +16,12 @@
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/sim/scenario.h"
 #include "problems/transfer_alignment/config.h"
 #include "problems/transfer_alignment/inputs.h"
 #include "problems/transfer_alignment/run.h"
 
-DECLARE_string(format);     // main.cc
-DECLARE_string(truth);      // cmd_ins.cc
-DECLARE_string(calibration);          // cmd_ins.cc
-DECLARE_double(imu_temperature_degC);  // cmd_ins.cc
-DECLARE_string(init_from);  // cmd_ins.cc
-DECLARE_double(start_s);    // cmd_ins.cc (NaN: the start of the slave IMU data)
-DECLARE_string(config);     // cmd_navigate.cc
-DECLARE_string(scenario);   // cmd_simulate.cc
-DECLARE_uint64(seed);       // cmd_simulate.cc
-DECLARE_string(method);     // cmd_inflight.cc
 DEFINE_string(master, "", "transfer-align: master INS navigation records as received (time tag = arrival)");
 DEFINE_string(slave_imu, "", "transfer-align: slave IMU file (its own axes, on the master's time scale)");
 DEFINE_double(delay_s, NAN, "transfer-align --scenario: transfer delay of the simulated master, s (default: the scenario's)");
@@ -53,12 +44,6 @@ const char* kUsage =
     "  brings its own, with the true mounting and delay). Configuration keys: data/configs/\n"
     "  transfer-alignment-high-maneuver.yaml. --method all runs the three (JSON: an array of three objects).";
 
-/// True when the flag was not set (compared as text: is_default is false for a NaN default).
-bool IsDefault(const char* flag) {
-  const gflags::CommandLineFlagInfo info = gflags::GetCommandLineFlagInfoOrDie(flag);
-  return info.current_value == info.default_value;
-}
-
 int Usage(const std::string& why) {
   std::cerr << "navtwin transfer-align: " << why << "\nusage: " << kUsage << "\n";
   return kExitUsage;
@@ -80,18 +65,18 @@ int RunTransferAlign(const std::vector<std::string>& args) {
   const bool scenario = !FLAGS_scenario.empty();
   if (scenario) {
     for (const char* flag : {"master", "slave_imu", "init_from", "start_s", "truth", "calibration", "imu_temperature_degC"}) {
-      if (!IsDefault(flag)) return Usage(std::string("--scenario simulates its own files: drop --") + flag);
+      if (FlagGiven(flag)) return Usage(std::string("--scenario simulates its own files: drop --") + flag);
     }
-    if (!IsDefault("delay_s") && !(std::isfinite(FLAGS_delay_s) && FLAGS_delay_s >= 0.0)) {
+    if (FlagGiven("delay_s") && !(std::isfinite(FLAGS_delay_s) && FLAGS_delay_s >= 0.0)) {
       return Usage("--delay_s must be a delay >= 0, s");
     }
   } else {
     if (FLAGS_master.empty() || FLAGS_slave_imu.empty()) return Usage("--master and --slave_imu are required (or --scenario)");
     if (FLAGS_init_from.empty()) return Usage("--init_from NAV is required: the slave INS's initial state");
-    if (!IsDefault("seed")) return Usage("--seed goes with --scenario");
-    if (!IsDefault("delay_s")) return Usage("--delay_s goes with --scenario");
+    if (FlagGiven("seed")) return Usage("--seed goes with --scenario");
+    if (FlagGiven("delay_s")) return Usage("--delay_s goes with --scenario");
     if (!std::isnan(FLAGS_start_s) && !std::isfinite(FLAGS_start_s)) return Usage("--start_s must be a time, s");
-    if (FLAGS_calibration.empty() && !IsDefault("imu_temperature_degC")) {
+    if (FLAGS_calibration.empty() && FlagGiven("imu_temperature_degC")) {
       return Usage("--imu_temperature_degC goes with --calibration");
     }
   }
@@ -101,7 +86,7 @@ int RunTransferAlign(const std::vector<std::string>& args) {
   if (scenario) {
     const sim::Scenario s = sim::LoadScenario(FLAGS_scenario);
     if (!s.master) throw std::invalid_argument("scenario " + s.name + " has no master section (transfer alignment needs one)");
-    const std::optional<double> delay = IsDefault("delay_s") ? std::nullopt : std::optional<double>(FLAGS_delay_s);
+    const std::optional<double> delay = FlagGiven("delay_s") ? std::optional<double>(FLAGS_delay_s) : std::nullopt;
     std::fprintf(stderr, "transfer-align: simulating %s (seed %llu, transfer delay %g s)\n", s.name.c_str(),
                  static_cast<unsigned long long>(FLAGS_seed), delay ? *delay : s.master->transfer_delay_s);
     inputs = transfer::SimulateTransferInputs(s, FLAGS_seed, delay);

@@ -10,12 +10,12 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
@@ -23,10 +23,6 @@
 #include "problems/transfer_alignment/config.h"
 #include "problems/transfer_alignment/run.h"
 
-DECLARE_string(format);  // main.cc
-DECLARE_string(config);  // cmd_navigate.cc
-DECLARE_string(method);  // cmd_inflight.cc
-DEFINE_string(data, "", "transfer-align-ansfl: the ansfl-quadrotor folder (with StraightLine/ and Horizontal/)");
 DEFINE_string(csv, "", "transfer-align-ansfl: write one row per path and DOT to this CSV file");
 
 namespace navtwin::app {
@@ -45,75 +41,16 @@ int Usage(const std::string& why) {
   return kExitUsage;
 }
 
-bool Ok(const AnsflAlignment& a) { return a.note.empty() || a.note == "no epoch after settle_s"; }
-// CoarseAlignAnsfl sets the correlation (> 0 at its peak); it stays 0 when the coarse step failed.
-bool CoarseOk(const AnsflAlignment& a) { return a.coarse.correlation > 0.0; }
+using transfer::AnsflCoarseOk;
+using transfer::AnsflRefined;
+using transfer::DotRepeatability;
+using transfer::SampleSpread;
 
 Eigen::Vector3d CoarseDeg(const AnsflAlignment& a) { return EulerFromQuat(a.coarse.mounting) * kRadToDeg; }
 
-/// Mean, standard deviation and max - min of angles (deg) that may wrap at +-180 (the DOT roll
-/// is near 180): each is first brought next to the first one.
-struct Spread {
-  int n = 0;
-  double mean = std::nan(""), std = std::nan(""), range = std::nan("");
-};
-
-Spread SpreadOf(const std::vector<double>& x, bool angle_deg) {
-  Spread s;
-  s.n = static_cast<int>(x.size());
-  if (x.empty()) return s;
-  std::vector<double> u;
-  for (double v : x) u.push_back(angle_deg ? x[0] + WrapPi((v - x[0]) * kDegToRad) * kRadToDeg : v);
-  double sum = 0.0;
-  for (double v : u) sum += v;
-  s.mean = sum / u.size();
-  double ss = 0.0;
-  for (double v : u) ss += (v - s.mean) * (v - s.mean);
-  s.std = u.size() > 1 ? std::sqrt(ss / (u.size() - 1)) : std::nan("");
-  s.range = *std::max_element(u.begin(), u.end()) - *std::min_element(u.begin(), u.end());
-  if (angle_deg) s.mean = WrapPi(s.mean * kDegToRad) * kRadToDeg;
-  return s;
-}
-
-struct DotRepeatability {
-  int dot = 0;
-  std::string group;  ///< "all", "StraightLine" or "Horizontal"
-  Spread coarse[3], refined[3], delay_ms, residual_mrad;
-};
-
-/// Per DOT, over all paths and over each flight type (their excitation differs: the
-/// StraightLine flights barely rotate, the Horizontal ones spin in yaw).
-std::vector<DotRepeatability> Repeatability(const std::vector<AnsflAlignment>& runs) {
-  std::map<std::pair<int, std::string>, std::vector<const AnsflAlignment*>> by_dot;
-  for (const AnsflAlignment& a : runs) {
-    by_dot[{a.dot, "all"}].push_back(&a);
-    by_dot[{a.dot, a.path.substr(0, a.path.find('/'))}].push_back(&a);
-  }
-  std::vector<DotRepeatability> out;
-  for (const auto& [key, list] : by_dot) {
-    DotRepeatability r;
-    r.dot = key.first;
-    r.group = key.second;
-    for (int i = 0; i < 3; ++i) {
-      std::vector<double> c, f;
-      for (const AnsflAlignment* a : list) {
-        if (CoarseOk(*a)) c.push_back(CoarseDeg(*a)[i]);
-        if (Ok(*a)) f.push_back(a->result.misalignment_deg[i]);
-      }
-      r.coarse[i] = SpreadOf(c, true);
-      r.refined[i] = SpreadOf(f, true);
-    }
-    std::vector<double> d, res;
-    for (const AnsflAlignment* a : list) {
-      if (!Ok(*a)) continue;
-      d.push_back(a->result.delay_s * 1e3);
-      if (std::isfinite(a->residual_attitude_mrad)) res.push_back(a->residual_attitude_mrad);
-    }
-    r.delay_ms = SpreadOf(d, false);
-    r.residual_mrad = SpreadOf(res, false);
-    out.push_back(r);
-  }
-  return out;
+/// A spread in the printed unit: every field times `scale`.
+SampleSpread Scaled(const SampleSpread& s, double scale) {
+  return {s.n, s.mean * scale, s.std * scale, s.range * scale};
 }
 
 std::string Cell(double x, const char* fmt) {
@@ -133,13 +70,13 @@ void PrintText(const std::vector<AnsflAlignment>& runs, const std::vector<DotRep
               "refined r/p/y deg", "sigma mrad", "delay ms", "res_mrad");
   for (const AnsflAlignment& a : runs) {
     std::printf("%-20s %3d ", a.path.c_str(), a.dot);
-    if (!CoarseOk(a)) {
+    if (!AnsflCoarseOk(a)) {
       std::printf("skipped: %s\n", a.note.c_str());
       continue;
     }
     const Eigen::Vector3d c = CoarseDeg(a);
     std::printf("%8.3f %5.3f %7.2f %7.2f %7.2f ", a.coarse.clock_offset_s, a.coarse.correlation, c.x(), c.y(), c.z());
-    if (!Ok(a)) {
+    if (!AnsflRefined(a)) {
       std::printf("not refined: %s\n", a.note.c_str());
       continue;
     }
@@ -153,17 +90,19 @@ void PrintText(const std::vector<AnsflAlignment>& runs, const std::vector<DotRep
               "refined roll deg", "refined pitch deg", "refined yaw deg", "delay ms");
   for (const DotRepeatability& r : rep) {
     char coarse[64];
-    std::snprintf(coarse, sizeof coarse, "%.2f/%.2f/%.2f", r.coarse[0].std, r.coarse[1].std, r.coarse[2].std);
-    const auto fmt = [](const Spread& s, const char* unit_fmt) {
+    std::snprintf(coarse, sizeof coarse, "%.2f/%.2f/%.2f", r.coarse_rad[0].std * kRadToDeg,
+                  r.coarse_rad[1].std * kRadToDeg, r.coarse_rad[2].std * kRadToDeg);
+    const auto fmt = [](const SampleSpread& s, const char* unit_fmt) {
       return Cell(s.std, unit_fmt) + " / " + Cell(s.range, unit_fmt) + " [" + Cell(s.mean, unit_fmt) + "]";
     };
-    std::printf("%3d %-12s %3d %-24s %-26s %-26s %-26s %s\n", r.dot, r.group.c_str(), r.refined[0].n, coarse,
-                fmt(r.refined[0], "%.2f").c_str(), fmt(r.refined[1], "%.2f").c_str(), fmt(r.refined[2], "%.2f").c_str(),
-                fmt(r.delay_ms, "%.1f").c_str());
+    std::printf("%3d %-12s %3d %-24s %-26s %-26s %-26s %s\n", r.dot, r.group.c_str(), r.mounting_rad[0].n, coarse,
+                fmt(Scaled(r.mounting_rad[0], kRadToDeg), "%.2f").c_str(),
+                fmt(Scaled(r.mounting_rad[1], kRadToDeg), "%.2f").c_str(),
+                fmt(Scaled(r.mounting_rad[2], kRadToDeg), "%.2f").c_str(), fmt(Scaled(r.delay_s, 1e3), "%.1f").c_str());
   }
 }
 
-void WriteSpread(JsonWriter& w, const std::string& key, const Spread& s) {
+void WriteSpread(JsonWriter& w, const std::string& key, const SampleSpread& s) {
   w.Key(key)
       .BeginObject()
       .Field("n", s.n)
@@ -182,13 +121,13 @@ std::string Json(const std::vector<AnsflAlignment>& runs, const std::vector<DotR
   w.BeginObject().Field("method", transfer::MethodName(method)).Key("runs").BeginArray();
   for (const AnsflAlignment& a : runs) {
     w.BeginObject().Field("path", a.path).Field("dot", a.dot);
-    if (CoarseOk(a)) {
+    if (AnsflCoarseOk(a)) {
       w.Field("coarse_offset_s", a.coarse.clock_offset_s).Field("coarse_correlation", a.coarse.correlation);
       vec("coarse_mounting_deg", CoarseDeg(a));
       vec("coarse_gyro_bias_dps", a.coarse.gyro_bias_s_radps * kRadToDeg);
       w.Field("coarse_rate_residual_dps", a.coarse.rate_residual_rms_radps * kRadToDeg);
     }
-    if (Ok(a)) {
+    if (AnsflRefined(a)) {
       vec("mounting_deg", a.result.misalignment_deg);
       vec("mounting_sigma_mrad", a.result.misalignment_sigma_mrad);
       w.Field("delay_s", a.result.delay_s)
@@ -202,10 +141,12 @@ std::string Json(const std::vector<AnsflAlignment>& runs, const std::vector<DotR
   const char* axes[3] = {"roll", "pitch", "yaw"};
   for (const DotRepeatability& r : rep) {
     w.BeginObject().Field("dot", r.dot).Field("paths", r.group);
-    for (int i = 0; i < 3; ++i) WriteSpread(w, std::string("coarse_") + axes[i] + "_deg", r.coarse[i]);
-    for (int i = 0; i < 3; ++i) WriteSpread(w, std::string(axes[i]) + "_deg", r.refined[i]);
-    WriteSpread(w, "delay_ms", r.delay_ms);
-    WriteSpread(w, "residual_attitude_mrad", r.residual_mrad);
+    for (int i = 0; i < 3; ++i) {
+      WriteSpread(w, std::string("coarse_") + axes[i] + "_deg", Scaled(r.coarse_rad[i], kRadToDeg));
+    }
+    for (int i = 0; i < 3; ++i) WriteSpread(w, std::string(axes[i]) + "_deg", Scaled(r.mounting_rad[i], kRadToDeg));
+    WriteSpread(w, "delay_ms", Scaled(r.delay_s, 1e3));
+    WriteSpread(w, "residual_attitude_mrad", Scaled(r.residual_rad, 1e3));
     w.EndObject();
   }
   w.EndArray().EndObject();
@@ -220,7 +161,7 @@ void WriteCsv(const std::vector<AnsflAlignment>& runs, const std::string& path) 
        "pitch_sigma_mrad,yaw_sigma_mrad,delay_s,delay_sigma_s,residual_attitude_mrad,note\n";
   for (const AnsflAlignment& a : runs) {
     const double nan = std::nan("");
-    const bool c = CoarseOk(a), r = Ok(a);
+    const bool c = AnsflCoarseOk(a), r = AnsflRefined(a);
     const Eigen::Vector3d cm = c ? CoarseDeg(a) : Eigen::Vector3d::Constant(nan);
     const Eigen::Vector3d bias =
         c ? Eigen::Vector3d(a.coarse.gyro_bias_s_radps * kRadToDeg) : Eigen::Vector3d::Constant(nan);
@@ -254,14 +195,14 @@ int RunTransferAlignAnsfl(const std::vector<std::string>& args) {
   const transfer::TransferConfig config =
       FLAGS_config.empty() ? transfer::AnsflDotConfig() : transfer::LoadTransferConfig(FLAGS_config);
   const std::vector<AnsflAlignment> runs = transfer::AlignAllAnsfl(FLAGS_data, config, method);
-  const std::vector<DotRepeatability> rep = Repeatability(runs);
+  const std::vector<DotRepeatability> rep = transfer::AnsflRepeatability(runs);
   if (!FLAGS_csv.empty()) WriteCsv(runs, FLAGS_csv);
   if (FLAGS_format == "json") {
     std::cout << Json(runs, rep, method) << "\n";
   } else {
     PrintText(runs, rep, method);
   }
-  return std::any_of(runs.begin(), runs.end(), Ok) ? kExitOk : kExitFailure;
+  return std::any_of(runs.begin(), runs.end(), AnsflRefined) ? kExitOk : kExitFailure;
 }
 
 }  // namespace

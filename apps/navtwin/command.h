@@ -26,6 +26,12 @@ Command NavigateCommand();
 Command SmoothCommand();
 Command LevelCommand();
 Command LevelMcCommand();
+Command InflightAlignCommand();
+Command InflightMcCommand();
+Command TransferAlignCommand();
+Command TransferAlignAnsflCommand();
+Command CalibrateImuCommand();
+Command CalibrateMagCommand();
 
 /// Exit codes shared by all subcommands.
 constexpr int kExitOk = 0;

@@ -4,27 +4,19 @@
 #include <glog/logging.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <exception>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "apps/navtwin/command.h"
+#include "apps/navtwin/common_flags.h"
 #include "core/io/input_error.h"
 
-DEFINE_string(format, "text", "Output format of printed results: text or json");
-
 namespace navtwin::app {
-
-// cmd_inflight.cc (declared here rather than in command.h, which another change owns).
-Command InflightAlignCommand();
-Command InflightMcCommand();
-// cmd_transfer.cc
-Command TransferAlignCommand();
-Command TransferAlignAnsflCommand();  // cmd_transfer_ansfl.cc
-Command CalibrateMagCommand();        // cmd_calibrate_mag.cc
-Command CalibrateImuCommand();        // cmd_calibrate_imu.cc
 
 namespace {
 
@@ -58,6 +50,61 @@ void PrintCommandHelp(const Command& c) {
   }
 }
 
+/// Parses the flags after the subcommand into gflags, or names what is wrong. Unlike
+/// gflags::ParseCommandLineFlags (which exits 1), an unknown flag or a value its type does
+/// not take is reported here, so that the caller exits 2. The syntax is gflags': one or
+/// two leading dashes, --name=value, --name value (not for booleans), --name and --noname
+/// (booleans); "--" ends the flags. Arguments that are not flags go to *positional, in order.
+bool ParseFlags(const std::vector<std::string>& argv, std::vector<std::string>* positional,
+                std::string* error) {
+  for (std::size_t i = 0; i < argv.size(); ++i) {
+    const std::string& arg = argv[i];
+    if (arg == "--") {
+      positional->insert(positional->end(), argv.begin() + static_cast<std::ptrdiff_t>(i) + 1, argv.end());
+      break;
+    }
+    if (arg.size() < 2 || arg[0] != '-') {
+      positional->push_back(arg);
+      continue;
+    }
+    const std::string body = arg.substr(arg[1] == '-' ? 2 : 1);
+    const std::size_t eq = body.find('=');
+    std::string name = body.substr(0, eq);
+    std::optional<std::string> value;
+    if (eq != std::string::npos) value = body.substr(eq + 1);
+    gflags::CommandLineFlagInfo info;
+    if (!gflags::GetCommandLineFlagInfo(name.c_str(), &info)) {
+      const bool negated_bool = !value && name.rfind("no", 0) == 0 &&
+                                gflags::GetCommandLineFlagInfo(name.substr(2).c_str(), &info) && info.type == "bool";
+      if (!negated_bool) {
+        *error = "unknown flag --" + name;
+        return false;
+      }
+      name = name.substr(2);
+      value = "false";
+    }
+    if (!value) {
+      if (info.type == "bool") {
+        value = "true";
+      } else if (i + 1 < argv.size()) {
+        value = argv[++i];
+      } else {
+        *error = "flag --" + name + " needs a value";
+        return false;
+      }
+    }
+    if (gflags::SetCommandLineOption(name.c_str(), value->c_str()).empty()) {
+      *error = "bad value '" + *value + "' for --" + name + " (" + info.type + ")";
+      return false;
+    }
+  }
+  return true;
+}
+
+void PrintVersion() {
+  std::cout << "navtwin " << NAVTWIN_VERSION << " (commit " << NAVTWIN_GIT_COMMIT << ")\n";
+}
+
 /// Flags set on the command line that the chosen subcommand does not read.
 std::vector<std::string> ForeignFlags(const Command& c) {
   std::vector<gflags::CommandLineFlagInfo> all;
@@ -80,6 +127,10 @@ int Main(int argc, char** argv) {
     PrintMainHelp(commands);
     return argc < 2 ? kExitUsage : kExitOk;
   }
+  if (std::strcmp(argv[1], "--version") == 0) {
+    PrintVersion();
+    return kExitOk;
+  }
   const std::string sub = argv[1];
   const auto it = std::find_if(commands.begin(), commands.end(),
                                [&](const Command& c) { return c.name == sub; });
@@ -92,12 +143,17 @@ int Main(int argc, char** argv) {
       PrintCommandHelp(*it);
       return kExitOk;
     }
+    if (std::strcmp(argv[i], "--version") == 0) {
+      PrintVersion();
+      return kExitOk;
+    }
   }
-  // Parse the flags after the subcommand; what remains are its positional arguments.
-  int sub_argc = argc - 1;
-  char** sub_argv = argv + 1;
-  gflags::SetUsageMessage(it->usage);
-  gflags::ParseCommandLineFlags(&sub_argc, &sub_argv, /*remove_flags=*/true);
+  std::vector<std::string> args;
+  std::string error;
+  if (!ParseFlags(std::vector<std::string>(argv + 2, argv + argc), &args, &error)) {
+    std::cerr << "navtwin " << sub << ": " << error << "\nusage: " << it->usage << "\n";
+    return kExitUsage;
+  }
   const std::vector<std::string> foreign = ForeignFlags(*it);
   if (!foreign.empty()) {
     std::cerr << "navtwin " << sub << ": flag --" << foreign.front()
@@ -108,7 +164,6 @@ int Main(int argc, char** argv) {
     std::cerr << "navtwin " << sub << ": --format must be text or json\n";
     return kExitUsage;
   }
-  std::vector<std::string> args(sub_argv + 1, sub_argv + sub_argc);
   try {
     return it->run(args);
   } catch (const InputError& e) {

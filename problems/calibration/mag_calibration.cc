@@ -270,6 +270,10 @@ class RobustSandwich {
 
 }  // namespace
 
+double FieldMagnitudeSpread_uT(const std::vector<MagSample>& samples) {
+  return MeanStd(Magnitudes(samples)).second;
+}
+
 Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector3d& m_uT) {
   return c.correction * (m_uT - c.hard_iron_uT);
 }
@@ -390,7 +394,7 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
   c.hard_iron_sigma_uT = sigma.head<3>();
   c.correction_sigma = sigma.tail<6>();
   c.residual_rms_uT = std::sqrt(ss / n);
-  c.field_spread_before_uT = MeanStd(Magnitudes(samples)).second;
+  c.field_spread_before_uT = FieldMagnitudeSpread_uT(samples);
   c.field_spread_after_uT = MeanStd(after).second;
   c.samples = n;
   c.downweighted = sandwich.downweighted();

@@ -140,6 +140,10 @@ struct BidirectionalOptions {
 MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std::vector<Eigen::Vector2d>& roll_pitch_rad,
                                 const BidirectionalOptions& options = {});
 
+/// Population standard deviation of |m| over the samples, uT (0 for none): the spread a
+/// calibration should shrink, and what a refused fit reports about its data.
+double FieldMagnitudeSpread_uT(const std::vector<MagSample>& samples);
+
 /// Heading (rad, true north) from a calibrated 3-axis body-axis field, roll and pitch.
 double TiltCompensatedHeading(const Eigen::Vector3d& m_b_uT, double roll_rad, double pitch_rad, double declination_rad);
 /// Heading from the horizontal (x, y) components only (2-axis sensor, level).

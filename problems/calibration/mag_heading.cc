@@ -77,4 +77,33 @@ HeadingErrors MagHeadingErrors(const std::vector<MagSample>& mag,
   return e;
 }
 
+MagSampleAttitudes AttitudesFromNav(const std::vector<MagSample>& mag, const std::vector<NavState>& nav) {
+  MagSampleAttitudes a;
+  a.source = "truth";
+  a.euler_rad.resize(mag.size());
+  a.roll_pitch_rad.resize(mag.size());
+  for (std::size_t i = 0; i < mag.size(); ++i) {
+    a.euler_rad[i] = EulerAt(nav, mag[i].t_s);
+    if (a.euler_rad[i]) a.roll_pitch_rad[i] = a.euler_rad[i]->head<2>();
+  }
+  return a;
+}
+
+MagSampleAttitudes AttitudesFromAccelerometer(const std::vector<MagSample>& mag, std::vector<ImuSample> imu) {
+  MagSampleAttitudes a;
+  a.source = "imu accelerometer";
+  a.euler_rad.resize(mag.size());
+  const AccelerometerLevel level(std::move(imu), 0.5 * MedianInterval_s(mag));
+  for (const MagSample& m : mag) a.roll_pitch_rad.push_back(level.At(m.t_s));
+  return a;
+}
+
+MagSampleAttitudes LevelAttitudes(const std::vector<MagSample>& mag) {
+  MagSampleAttitudes a;
+  a.source = "level (assumed)";
+  a.euler_rad.resize(mag.size());
+  a.roll_pitch_rad.assign(mag.size(), Eigen::Vector2d::Zero());
+  return a;
+}
+
 }  // namespace navtwin::calibration

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -57,5 +58,23 @@ struct HeadingErrors {
 HeadingErrors MagHeadingErrors(const std::vector<MagSample>& mag,
                                const std::vector<std::optional<Eigen::Vector3d>>& reference_euler_rad,
                                const MagCalibration& c, bool two_axis, double declination_rad);
+
+/// The reference attitude of each magnetometer sample, for the bidirectional method's tilt
+/// gate and the tilt-compensated heading: from a navigation record (roll, pitch and yaw), else
+/// from an IMU's accelerometer (roll and pitch), else every sample taken as level.
+struct MagSampleAttitudes {
+  std::string source;  ///< "truth", "imu accelerometer" or "level (assumed)"
+  /// Roll, pitch, yaw per sample (nullopt outside the record); all nullopt unless from a
+  /// navigation record.
+  std::vector<std::optional<Eigen::Vector3d>> euler_rad;
+  std::vector<std::optional<Eigen::Vector2d>> roll_pitch_rad;  ///< nullopt outside the record
+};
+
+/// EulerAt of a time-sorted navigation record at every sample.
+MagSampleAttitudes AttitudesFromNav(const std::vector<MagSample>& mag, const std::vector<NavState>& nav);
+/// AccelerometerLevel at every sample, averaging within half the median magnetometer interval.
+MagSampleAttitudes AttitudesFromAccelerometer(const std::vector<MagSample>& mag, std::vector<ImuSample> imu);
+/// Roll and pitch 0 at every sample, no yaw.
+MagSampleAttitudes LevelAttitudes(const std::vector<MagSample>& mag);
 
 }  // namespace navtwin::calibration

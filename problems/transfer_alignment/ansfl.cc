@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -491,6 +492,66 @@ std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const Tra
       out.push_back(a);
     }
   }
+  return out;
+}
+
+bool AnsflCoarseOk(const AnsflAlignment& a) { return a.coarse.correlation > 0.0; }
+
+bool AnsflRefined(const AnsflAlignment& a) { return a.note.empty() || a.note == "no epoch after settle_s"; }
+
+SampleSpread SpreadOf(const std::vector<double>& values, bool angle_rad) {
+  SampleSpread s;
+  s.n = static_cast<int>(values.size());
+  if (values.empty()) return s;
+  std::vector<double> u;
+  for (const double v : values) u.push_back(angle_rad ? values[0] + WrapPi(v - values[0]) : v);
+  double sum = 0.0;
+  for (const double v : u) sum += v;
+  s.mean = sum / static_cast<double>(u.size());
+  double ss = 0.0;
+  for (const double v : u) ss += (v - s.mean) * (v - s.mean);
+  if (u.size() > 1) s.std = std::sqrt(ss / static_cast<double>(u.size() - 1));
+  s.range = *std::max_element(u.begin(), u.end()) - *std::min_element(u.begin(), u.end());
+  if (angle_rad) s.mean = WrapPi(s.mean);
+  return s;
+}
+
+namespace {
+
+DotRepeatability RepeatabilityOf(int dot, const std::string& group, const std::vector<const AnsflAlignment*>& list) {
+  DotRepeatability r;
+  r.dot = dot;
+  r.group = group;
+  for (int i = 0; i < 3; ++i) {
+    std::vector<double> coarse, refined;
+    for (const AnsflAlignment* a : list) {
+      if (AnsflCoarseOk(*a)) coarse.push_back(EulerFromQuat(a->coarse.mounting)[i]);
+      if (AnsflRefined(*a)) refined.push_back(a->result.misalignment_deg[i] * kDegToRad);
+    }
+    r.coarse_rad[i] = SpreadOf(coarse, true);
+    r.mounting_rad[i] = SpreadOf(refined, true);
+  }
+  std::vector<double> delay, residual;
+  for (const AnsflAlignment* a : list) {
+    if (!AnsflRefined(*a)) continue;
+    delay.push_back(a->result.delay_s);
+    if (std::isfinite(a->residual_attitude_mrad)) residual.push_back(a->residual_attitude_mrad * 1e-3);
+  }
+  r.delay_s = SpreadOf(delay, false);
+  r.residual_rad = SpreadOf(residual, false);
+  return r;
+}
+
+}  // namespace
+
+std::vector<DotRepeatability> AnsflRepeatability(const std::vector<AnsflAlignment>& runs) {
+  std::map<std::pair<int, std::string>, std::vector<const AnsflAlignment*>> by_dot;
+  for (const AnsflAlignment& a : runs) {
+    by_dot[{a.dot, "all"}].push_back(&a);
+    by_dot[{a.dot, a.path.substr(0, a.path.find('/'))}].push_back(&a);
+  }
+  std::vector<DotRepeatability> out;
+  for (const auto& [key, list] : by_dot) out.push_back(RepeatabilityOf(key.first, key.second, list));
   return out;
 }
 

@@ -14,6 +14,7 @@
 // residual clock offset plus the DJI solution's own latency).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -63,5 +64,37 @@ TransferConfig AnsflDotConfig();
 /// Every StraightLine/path_* and Horizontal/path_* under data_dir and every IMU_k.csv in
 /// it, with the given method. Progress on stderr.
 std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const TransferConfig& config, Method method);
+
+/// The coarse step succeeded (CoarseAlignAnsfl set a correlation > 0 at its peak).
+bool AnsflCoarseOk(const AnsflAlignment& a);
+/// The refinement gave a mounting and delay (no note, or only "no epoch after settle_s").
+bool AnsflRefined(const AnsflAlignment& a);
+
+/// Mean, sample standard deviation (n - 1; NaN for one value) and max - min of values; NaN
+/// for none. Angles (rad) that may wrap at +-pi (the DOT roll is near pi) are first brought
+/// next to the first one, and their mean is wrapped to (-pi, pi].
+struct SampleSpread {
+  int n = 0;
+  double mean = std::numeric_limits<double>::quiet_NaN();
+  double std = std::numeric_limits<double>::quiet_NaN();
+  double range = std::numeric_limits<double>::quiet_NaN();
+};
+SampleSpread SpreadOf(const std::vector<double>& values, bool angle_rad);
+
+/// One DOT's mounting and delay across the paths of a group: the score of an alignment
+/// without truth.
+struct DotRepeatability {
+  int dot = 0;
+  std::string group;              ///< "all", "StraightLine" or "Horizontal"
+  SampleSpread coarse_rad[3];     ///< coarse mounting roll, pitch, yaw (paths with AnsflCoarseOk)
+  SampleSpread mounting_rad[3];   ///< refined mounting roll, pitch, yaw (paths with AnsflRefined)
+  SampleSpread delay_s;           ///< refined delay
+  SampleSpread residual_rad;      ///< residual attitude (finite ones)
+};
+
+/// Per DOT (in increasing order), over all its paths and over each flight type (the path's
+/// first folder: their excitation differs, the StraightLine flights barely rotate, the
+/// Horizontal ones spin in yaw), groups in name order.
+std::vector<DotRepeatability> AnsflRepeatability(const std::vector<AnsflAlignment>& runs);
 
 }  // namespace navtwin::transfer

@@ -53,6 +53,43 @@ TEST(Cli, MisuseExitsWithUsageCode) {
   EXPECT_NE(foreign.err.find("init_lat_deg"), std::string::npos);
 }
 
+TEST(Cli, UnknownFlagExitsWithUsageCode) {
+  const RunResult r = Navtwin("navigate --nosuchflag");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown flag --nosuchflag"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("usage: navtwin navigate"), std::string::npos) << r.err;
+  EXPECT_EQ(Navtwin("info --nosuchflag=3 x.txt").exit_code, 2);
+  EXPECT_EQ(Navtwin("simulate --noperfectly").exit_code, 2);
+}
+
+TEST(Cli, BadFlagValueExitsWithUsageCode) {
+  const RunResult seed = Navtwin("simulate --scenario mems-gps-mag-maneuver --seed=abc --out x");
+  EXPECT_EQ(seed.exit_code, 2);
+  EXPECT_NE(seed.err.find("bad value 'abc' for --seed"), std::string::npos) << seed.err;
+  EXPECT_EQ(Navtwin("navigate --output_rate_hz fast").exit_code, 2);
+  EXPECT_EQ(Navtwin("level-mc --runs=1.5").exit_code, 2);
+  EXPECT_EQ(Navtwin("ins --demo=maybe").exit_code, 2);
+  const RunResult missing = Navtwin("allan --axis");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("--axis needs a value"), std::string::npos) << missing.err;
+}
+
+TEST(Cli, FlagSyntaxFollowsGflags) {
+  // --name value, --name=value, a boolean without a value, and "--" before positional arguments.
+  const std::string dir = MakeTempDir("flag_syntax");
+  const RunResult demo = Navtwin("ins --demo --demo_duration_s=2 --out " + dir);
+  ASSERT_EQ(demo.exit_code, 0) << demo.err;
+  const RunResult info = Navtwin("info --format=json -- " + dir + "/imu.txt");
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+}
+
+TEST(Cli, VersionPrintsProjectVersionAndCommit) {
+  const RunResult r = Navtwin("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_TRUE(std::regex_match(r.out, std::regex("navtwin [0-9]+\\.[0-9]+\\.[0-9]+ \\(commit ([0-9a-f]{4,}|unknown)\\)\n")))
+      << r.out;
+}
+
 TEST(Cli, InfoNamesTheLineWhereTimeGoesBackwards) {
   const std::string path = MakeTempDir("cli") + "/imu.txt";
   {

@@ -147,5 +147,48 @@ TEST(Allan, RelativeErrorFollowsIeee952) {
   EXPECT_TRUE(std::isinf(AllanRelativeError(1)));
 }
 
+TEST(Allan, ImuRatesUseTheMeanIntervalAndCountIrregularOnes) {
+  // 10 samples at 100 Hz, one of them 30 ms late (a dropped pair of samples).
+  std::vector<ImuSample> imu(10);
+  double t_s = 100.0;
+  for (std::size_t k = 0; k < imu.size(); ++k) {
+    imu[k].dt_s = k == 4 ? 0.03 : 0.01;
+    t_s += imu[k].dt_s;
+    imu[k].t_s = t_s;
+    imu[k].dtheta_b_rad = Eigen::Vector3d(1e-4, 2e-4, 3e-4) * static_cast<double>(k);
+    imu[k].dv_b_mps = Eigen::Vector3d(0.1, -0.2, -0.098) * static_cast<double>(k + 1);
+  }
+  const ImuRateRecord r = ImuRates(imu, {2, 3});
+  EXPECT_EQ(r.samples, 10u);
+  EXPECT_NEAR(r.duration_s, 0.12, 1e-12);
+  EXPECT_NEAR(r.tau0_s, 0.012, 1e-12);
+  // |0.01 - 0.012| = 0.002 > 10 % of tau0 for every interval; |0.03 - 0.012| too.
+  EXPECT_EQ(r.irregular_intervals, 10u);
+  ASSERT_EQ(r.rates.size(), 2u);
+  // Increment / tau0: the rates integrate back to the recorded increments.
+  double angle_rad = 0.0, dv_mps = 0.0;
+  for (std::size_t k = 0; k < imu.size(); ++k) {
+    EXPECT_NEAR(r.rates[0][k], imu[k].dtheta_b_rad.z() / 0.012, 1e-12);
+    angle_rad += r.rates[0][k] * r.tau0_s;
+    dv_mps += r.rates[1][k] * r.tau0_s;
+  }
+  EXPECT_NEAR(angle_rad, 3e-4 * 45.0, 1e-12);
+  EXPECT_NEAR(dv_mps, 0.1 * 55.0, 1e-12);
+  // With a looser threshold only the late sample is irregular.
+  EXPECT_EQ(ImuRates(imu, {0}, 0.5).irregular_intervals, 1u);
+}
+
+TEST(Allan, ImuRatesRejectBadInput) {
+  std::vector<ImuSample> imu(10);
+  for (std::size_t k = 0; k < imu.size(); ++k) {
+    imu[k].dt_s = 0.01;
+    imu[k].t_s = 0.01 * static_cast<double>(k + 1);
+  }
+  EXPECT_THROW(ImuRates(imu, {6}), std::invalid_argument);
+  EXPECT_THROW(ImuRates(imu, {-1}), std::invalid_argument);
+  imu.resize(3);
+  EXPECT_THROW(ImuRates(imu, {0}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace navtwin

@@ -632,3 +632,24 @@ TEST(RealData, Px4UlogMagnetometer) {
 
 }  // namespace
 }  // namespace navtwin::calibration
+
+namespace navtwin::calibration {
+namespace {
+
+TEST(FieldMagnitudeSpread, IsThePopulationStdOfTheFieldMagnitude) {
+  EXPECT_EQ(FieldMagnitudeSpread_uT({}), 0.0);
+  std::vector<MagSample> mag(4);
+  // |m| = 3, 5, 13, 5 uT: mean 6.5, population variance (12.25 + 2.25 + 42.25 + 2.25) / 4.
+  const Eigen::Vector3d m_uT[4] = {{3.0, 0.0, 0.0}, {0.0, 3.0, 4.0}, {5.0, 0.0, -12.0}, {0.0, -5.0, 0.0}};
+  for (int i = 0; i < 4; ++i) {
+    mag[i].t_s = 0.1 * i;
+    mag[i].m_b_uT = m_uT[i];
+  }
+  EXPECT_NEAR(FieldMagnitudeSpread_uT(mag), std::sqrt(59.0 / 4.0), 1e-12);
+  // A constant magnitude in any direction has no spread.
+  for (int i = 0; i < 4; ++i) mag[i].m_b_uT = 50.0 * m_uT[i].normalized();
+  EXPECT_NEAR(FieldMagnitudeSpread_uT(mag), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace navtwin::calibration

@@ -80,5 +80,49 @@ TEST(MagHeadingTest, HeadingErrorsBeforeAndAfterAHardIronCorrection) {
   EXPECT_DOUBLE_EQ(MedianInterval_s(mag), 1.0);
 }
 
+TEST(MagHeadingTest, SampleAttitudesFromNavAccelerometerOrLevel) {
+  std::vector<MagSample> mag(3);
+  for (int i = 0; i < 3; ++i) mag[i].t_s = 0.5 * i;  // 0, 0.5, 1.0 s
+  mag[2].t_s = 3.0;                                   // outside both records below
+
+  const std::vector<NavState> nav = {StateAt(0.0, 0.0), StateAt(1.0, 0.4)};
+  const MagSampleAttitudes from_nav = AttitudesFromNav(mag, nav);
+  EXPECT_EQ(from_nav.source, "truth");
+  ASSERT_EQ(from_nav.euler_rad.size(), 3u);
+  ASSERT_TRUE(from_nav.euler_rad[1].has_value());
+  EXPECT_NEAR((*from_nav.euler_rad[1])[2], 0.2, 1e-12);
+  EXPECT_NEAR((*from_nav.roll_pitch_rad[1])[0], 0.1, 1e-12);
+  EXPECT_NEAR((*from_nav.roll_pitch_rad[1])[1], -0.2, 1e-12);
+  EXPECT_FALSE(from_nav.euler_rad[2].has_value());
+  EXPECT_FALSE(from_nav.roll_pitch_rad[2].has_value());
+
+  const Eigen::Vector3d f_b = DcmFromEuler(0.1, -0.2, 0.0).transpose() * Eigen::Vector3d(0.0, 0.0, -9.81);
+  std::vector<ImuSample> imu;
+  for (int k = 1; k <= 100; ++k) {
+    ImuSample s;
+    s.t_s = 0.01 * k;
+    s.dt_s = 0.01;
+    s.dv_b_mps = f_b * s.dt_s;
+    imu.push_back(s);
+  }
+  const MagSampleAttitudes from_imu = AttitudesFromAccelerometer(mag, imu);
+  EXPECT_EQ(from_imu.source, "imu accelerometer");
+  ASSERT_EQ(from_imu.euler_rad.size(), 3u);
+  EXPECT_FALSE(from_imu.euler_rad[1].has_value());  // no yaw from an accelerometer
+  ASSERT_TRUE(from_imu.roll_pitch_rad[1].has_value());
+  EXPECT_NEAR((*from_imu.roll_pitch_rad[1])[0], 0.1, 1e-12);
+  EXPECT_NEAR((*from_imu.roll_pitch_rad[1])[1], -0.2, 1e-12);
+  EXPECT_FALSE(from_imu.roll_pitch_rad[2].has_value());
+
+  const MagSampleAttitudes level = LevelAttitudes(mag);
+  EXPECT_EQ(level.source, "level (assumed)");
+  ASSERT_EQ(level.roll_pitch_rad.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_FALSE(level.euler_rad[i].has_value());
+    ASSERT_TRUE(level.roll_pitch_rad[i].has_value());
+    EXPECT_EQ(level.roll_pitch_rad[i]->norm(), 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace navtwin::calibration

@@ -202,5 +202,73 @@ TEST(AnsflReal, SameDotAgreesOnTwoPaths) {
   EXPECT_LT(std::abs(rb.delay_s), 0.02);
 }
 
+TEST(AnsflRepeatability, SpreadOfAnglesWrapsAtPi) {
+  const SampleSpread none = SpreadOf({}, true);
+  EXPECT_EQ(none.n, 0);
+  EXPECT_TRUE(std::isnan(none.mean) && std::isnan(none.std) && std::isnan(none.range));
+  const SampleSpread one = SpreadOf({0.3}, false);
+  EXPECT_EQ(one.n, 1);
+  EXPECT_DOUBLE_EQ(one.mean, 0.3);
+  EXPECT_TRUE(std::isnan(one.std));
+  EXPECT_DOUBLE_EQ(one.range, 0.0);
+  // Roll near pi on both sides of the wrap: 179, -179, 178 deg are 1 deg apart, not 358.
+  const double d = kDegToRad;
+  const SampleSpread roll = SpreadOf({179.0 * d, -179.0 * d, 178.0 * d}, true);
+  EXPECT_EQ(roll.n, 3);
+  EXPECT_NEAR(roll.mean, (179.0 + 181.0 + 178.0) / 3.0 * d, 1e-12);
+  EXPECT_NEAR(roll.std, std::sqrt(7.0 / 3.0) * d, 1e-12);
+  EXPECT_NEAR(roll.range, 3.0 * d, 1e-12);
+  // The same values as plain numbers do not wrap.
+  EXPECT_NEAR(SpreadOf({179.0 * d, -179.0 * d, 178.0 * d}, false).range, 358.0 * d, 1e-12);
+  const SampleSpread plain = SpreadOf({1.0, 2.0, 3.0, 6.0}, false);
+  EXPECT_DOUBLE_EQ(plain.mean, 3.0);
+  EXPECT_NEAR(plain.std, std::sqrt(14.0 / 3.0), 1e-12);
+  EXPECT_DOUBLE_EQ(plain.range, 5.0);
+}
+
+AnsflAlignment Aligned(const std::string& path, int dot, double yaw_deg, double delay_s, const std::string& note = "") {
+  AnsflAlignment a;
+  a.path = path;
+  a.dot = dot;
+  a.coarse.correlation = 0.9;
+  a.coarse.mounting = Eigen::AngleAxisd(yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ());
+  a.result.misalignment_deg = Eigen::Vector3d(179.0, 0.0, yaw_deg);
+  a.result.delay_s = delay_s;
+  a.residual_attitude_mrad = 2.0;
+  a.note = note;
+  return a;
+}
+
+TEST(AnsflRepeatability, GroupsPerDotOverAllPathsAndPerFlightType) {
+  std::vector<AnsflAlignment> runs = {Aligned("StraightLine/path_1", 1, 10.0, 0.10),
+                                      Aligned("StraightLine/path_2", 1, 12.0, 0.12),
+                                      Aligned("Horizontal/path_1", 1, 11.0, 0.20),
+                                      Aligned("Horizontal/path_2", 1, 30.0, 0.90, "refinement failed"),
+                                      Aligned("Horizontal/path_1", 2, -5.0, 0.05)};
+  runs[4].coarse.correlation = 0.0;  // the coarse step failed for DOT 2
+  const std::vector<DotRepeatability> rep = AnsflRepeatability(runs);
+  ASSERT_EQ(rep.size(), 5u);  // DOT 1: Horizontal, StraightLine, all; DOT 2: Horizontal, all
+  EXPECT_EQ(rep[0].dot, 1);
+  EXPECT_EQ(rep[0].group, "Horizontal");
+  EXPECT_EQ(rep[1].group, "StraightLine");
+  EXPECT_EQ(rep[2].group, "all");
+  EXPECT_EQ(rep[3].dot, 2);
+  const DotRepeatability& all = rep[2];
+  // The failed refinement counts for the coarse spread only.
+  EXPECT_EQ(all.coarse_rad[2].n, 4);
+  EXPECT_EQ(all.mounting_rad[2].n, 3);
+  EXPECT_NEAR(all.mounting_rad[2].mean, 11.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(all.mounting_rad[2].range, 2.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(all.mounting_rad[0].mean, 179.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(all.delay_s.mean, 0.14, 1e-12);
+  EXPECT_NEAR(all.residual_rad.mean, 2e-3, 1e-15);
+  EXPECT_NEAR(rep[1].delay_s.range, 0.02, 1e-12);
+  EXPECT_EQ(rep[4].coarse_rad[2].n, 0);
+  EXPECT_EQ(rep[4].mounting_rad[2].n, 1);
+  EXPECT_TRUE(AnsflRefined(runs[0]));
+  EXPECT_FALSE(AnsflRefined(runs[3]));
+  EXPECT_FALSE(AnsflCoarseOk(runs[4]));
+}
+
 }  // namespace
 }  // namespace navtwin::transfer

@@ -1,0 +1,48 @@
+// Flags that several subcommands read, defined once (common_flags.cc) with one help text
+// that fits every subcommand using them. A flag that only one subcommand reads is defined
+// in that subcommand's file. Each subcommand lists the flags it reads in Command::flags.
+#pragma once
+
+#include <gflags/gflags.h>
+
+// Output and run control.
+DECLARE_string(format);
+DECLARE_string(out);
+DECLARE_uint64(seed);
+DECLARE_int32(runs);
+DECLARE_int32(threads);
+DECLARE_string(errors_csv);
+DECLARE_string(method);
+DECLARE_bool(demo);
+
+// Inputs.
+DECLARE_string(imu);
+DECLARE_string(gnss);
+DECLARE_string(mag);
+DECLARE_string(baro);
+DECLARE_string(truth);
+DECLARE_string(init_from);
+DECLARE_string(data);
+DECLARE_string(config);
+DECLARE_string(scenario);
+DECLARE_string(calibration);
+DECLARE_double(imu_temperature_degC);
+
+// Time span and output rate.
+DECLARE_double(start_s);
+DECLARE_double(end_s);
+DECLARE_double(output_rate_hz);
+
+// Leveling (level, level-mc).
+DECLARE_double(window_s);
+DECLARE_double(noise_mg);
+DECLARE_string(vib_axes);
+DECLARE_int32(vib_tones);
+
+namespace navtwin::app {
+
+/// Whether a flag was given a value other than its default. Compared as text, because
+/// CommandLineFlagInfo::is_default is false for a NaN default (NaN != NaN).
+bool FlagGiven(const char* name);
+
+}  // namespace navtwin::app

@@ -1,0 +1,323 @@
+#include "problems/gnss_ins/run.h"
+
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <memory>
+#include <ostream>
+#include <stdexcept>
+
+#include "core/io/atomic_file.h"
+#include "core/rotation.h"
+#include "core/sim/scenario.h"
+#include "core/sim/simulator.h"
+#include "problems/gnss_ins/batch.h"
+#include "problems/gnss_ins/densify.h"
+#include "problems/gnss_ins/filter.h"
+#include "problems/gnss_ins/output.h"
+#include "problems/gnss_ins/sim_config.h"
+
+namespace navtwin::gnss_ins {
+namespace {
+
+using Scorer = std::unique_ptr<TrajectoryScorer>;
+
+MethodRun Scored(const std::string& name, Solution solution, const Scorer& scorer) {
+  MethodRun m{name, std::move(solution), std::nullopt};
+  if (scorer) m.errors = scorer->Report();
+  return m;
+}
+
+/// A smoother's knots densified to the output epochs, scored, and written when `writer`.
+MethodRun DensifyAndScore(const std::string& name, Solution knots, const Inputs& inputs, double output_rate_hz,
+                          Scorer scorer, NavOutputWriter* writer) {
+  Densify(knots, inputs, output_rate_hz, [&](const NavEpoch& e) {
+    if (scorer) scorer->Add(e.state.nav);
+    if (writer) writer->Write(e);
+  });
+  return Scored(name, std::move(knots), scorer);
+}
+
+/// Filter, then RTS and batch as options.methods asks; the last one goes to `writer`.
+void RunEstimators(const RunOptions& options, const GnssInsConfig& config, const Inputs& inputs,
+                   NavOutputWriter* writer, GnssInsRun* run) {
+  const auto open_scorer = [&]() -> Scorer {
+    if (options.truth.empty()) return nullptr;
+    return OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
+  };
+  const bool run_rts = options.methods != RunMethods::kFilter;
+  const bool run_batch = options.methods == RunMethods::kAll;
+  if (options.progress) *options.progress << options.command << ": filter" << (run_rts ? " + RTS smoother" : "") << "\n";
+  const Scorer filter_scorer = open_scorer();
+  FilterResult fr = RunFilter(
+      inputs, config, run_rts,
+      [&](const NavEpoch& e) {
+        if (filter_scorer) filter_scorer->Add(e.state.nav);
+        if (!run_rts) writer->Write(e);
+      },
+      options.progress);
+  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer));
+  run->output_method = "filter";
+  if (!run_rts) return;
+  if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
+  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), inputs, config.output_rate_hz, open_scorer(),
+                                         run_batch ? nullptr : writer));
+  run->output_method = "rts";
+  if (!run_batch) return;
+  if (options.progress) {
+    *options.progress << options.command << ": batch smoother (Ceres) started from the RTS solution\n";
+  }
+  Solution batch = RunBatch(inputs, config, run->methods.back().solution, options.progress);
+  run->methods.push_back(
+      DensifyAndScore("batch", std::move(batch), inputs, config.output_rate_hz, open_scorer(), writer));
+  run->output_method = "batch";
+}
+
+double VelocityRms_mps(const NavErrorStats& s) {
+  return std::sqrt(s.Rms(3) * s.Rms(3) + s.Rms(4) * s.Rms(4) + s.Rms(5) * s.Rms(5));
+}
+
+void WriteStats(JsonWriter& w, const NavErrorStats& s, const ScoreReport& r) {
+  static const char* const kKeys[9] = {"pos_n_m",   "pos_e_m",   "pos_d_m",   "vel_n_mps", "vel_e_mps",
+                                       "vel_d_mps", "roll_deg",  "pitch_deg", "yaw_deg"};
+  w.BeginObject().Field("epochs", s.count());
+  for (int c = 0; c < 9; ++c) {
+    if (c >= 3 && c < 6 && !r.has_velocity) continue;
+    if (c >= 6 && !r.has_attitude) continue;
+    const double scale = c >= 6 ? kRadToDeg : 1.0;
+    w.Key(kKeys[c]).BeginObject().Field("rms", s.Rms(c) * scale).Field("max", s.Max(c) * scale).EndObject();
+  }
+  w.Key("horizontal_m").BeginObject().Field("rms", s.HorizontalRms_m()).Field("max", s.HorizontalMax_m()).EndObject();
+  w.Key("vertical_m").BeginObject().Field("rms", s.Rms(2)).Field("max", s.Max(2)).EndObject();
+  if (r.has_velocity) w.Field("velocity_rms_mps", VelocityRms_mps(s));
+  w.EndObject();
+}
+
+void WriteScore(JsonWriter& w, const ScoreReport& r) {
+  w.BeginObject().Field("reference", r.has_attitude ? "navigation" : "gnss");
+  w.Key("all");
+  WriteStats(w, r.all, r);
+  if (!r.outages.empty()) {
+    w.Key("outside_outages");
+    WriteStats(w, r.outside, r);
+    w.Key("inside_outages");
+    WriteStats(w, r.inside, r);
+    w.Key("outages").BeginArray();
+    for (const OutageDrift& d : r.outages) {
+      w.BeginObject()
+          .Field("start_s", d.start_s)
+          .Field("end_s", d.end_s)
+          .Field("epochs", d.epochs)
+          .Field("max_horizontal_m", d.max_horizontal_m)
+          .Field("max_vertical_m", d.max_vertical_m)
+          .EndObject();
+    }
+    w.EndArray();
+    w.Field("outage_horizontal_rms_m", r.outage_horizontal_rms_m);
+    w.Field("outage_vertical_rms_m", r.outage_vertical_rms_m);
+  }
+  w.EndObject();
+}
+
+void WriteInputs(JsonWriter& w, const RunOptions& options, const InputSummary& in) {
+  w.Key("inputs")
+      .BeginObject()
+      .Field("imu", in.paths.imu)
+      .Field("gnss", in.paths.gnss)
+      .Field("mag", in.paths.mag)
+      .Field("baro", in.paths.baro)
+      .Field("config", options.config_path)
+      .Field("imu_samples", in.imu_samples)
+      .Field("gnss_epochs", in.gnss_epochs)
+      .Field("mag_samples", in.mag_samples)
+      .Field("baro_samples", in.baro_samples)
+      .Field("bridged_imu_gaps", in.bridged_imu_gaps)
+      .Field("gnss_removed_by_outages", in.gnss_removed_by_outages)
+      .Field("t_start_s", in.t_start_s)
+      .Field("t_end_s", in.t_end_s)
+      .EndObject();
+  w.Key("outages").BeginArray();
+  for (const auto& o : in.outages) w.BeginArray().Value(o.first).Value(o.second).EndArray();
+  w.EndArray();
+}
+
+/// printf into a string.
+void Append(std::string* s, const char* format, ...) __attribute__((format(printf, 2, 3)));
+void Append(std::string* s, const char* format, ...) {
+  char buf[512];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(buf, sizeof buf, format, args);
+  va_end(args);
+  *s += buf;
+}
+
+void AppendErrorRow(std::string* s, const MethodRun& m, bool outages) {
+  const ScoreReport& r = *m.errors;
+  const NavErrorStats& e = r.all;
+  const auto cell = [s](bool have, double x) {
+    if (have) {
+      Append(s, " %10.3f", x);
+    } else {
+      Append(s, " %10s", "-");
+    }
+  };
+  Append(s, "%-7s", m.name.c_str());
+  cell(true, e.HorizontalRms_m());
+  cell(true, e.Rms(2));
+  cell(r.has_velocity, VelocityRms_mps(e));
+  cell(r.has_attitude, e.Rms(6) * kRadToDeg);
+  cell(r.has_attitude, e.Rms(7) * kRadToDeg);
+  cell(r.has_attitude, e.Rms(8) * kRadToDeg);
+  if (outages) Append(s, " %10.3f %10.3f", r.outage_horizontal_rms_m, r.outage_vertical_rms_m);
+  Append(s, " %10.2f\n", m.solution.run_time_s);
+}
+
+}  // namespace
+
+InputSummary SummarizeInputs(const Inputs& inputs) {
+  InputSummary s;
+  s.paths = inputs.paths;
+  s.imu_samples = inputs.imu.size();
+  s.gnss_epochs = inputs.gnss.size();
+  s.mag_samples = inputs.mag.size();
+  s.baro_samples = inputs.baro.size();
+  s.bridged_imu_gaps = inputs.bridged_imu_gaps;
+  s.gnss_removed_by_outages = inputs.gnss_removed_by_outages;
+  if (!inputs.imu.empty()) {
+    s.t_start_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
+    s.t_end_s = inputs.imu.back().t_s;
+  }
+  s.outages = inputs.outages;
+  return s;
+}
+
+GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const InputPaths& p = options.paths;
+  if (options.progress) {
+    *options.progress << options.command << ": reading " << p.imu << ", " << p.gnss
+                      << (p.mag.empty() ? "" : ", " + p.mag) << (p.baro.empty() ? "" : ", " + p.baro) << "\n";
+  }
+  const Inputs inputs = LoadInputs(p, config);
+  if (config.init.state && std::isnan(config.init.state->nav.t_s)) {
+    config.init.state->nav.t_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
+  }
+  if (inputs.bridged_imu_gaps > 0 && options.progress) {
+    *options.progress << options.command << ": bridged " << inputs.bridged_imu_gaps << " short IMU gap(s)\n";
+  }
+  GnssInsRun run;
+  run.inputs = SummarizeInputs(inputs);
+  run.output_rate_hz = config.output_rate_hz;
+  NavOutputWriter writer(options.out_dir, config.filter.scale_factors);
+  RunEstimators(options, config, inputs, &writer, &run);
+  run.output_epochs = writer.count();
+  if (run.output_epochs == 0) throw std::runtime_error("the run produced no output epoch");
+  run.total_run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // summary.json first (it can still fail), then the solution files.
+  const std::string summary = options.out_dir + "/summary.json";
+  WriteJsonFile(summary, [&](JsonWriter& w) { WriteRunSummary(w, options, run); });
+  try {
+    writer.Commit();
+  } catch (...) {
+    std::remove(summary.c_str());
+    throw;
+  }
+  return run;
+}
+
+void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun& run) {
+  w.BeginObject().Field("command", options.command).Field("output_method", run.output_method);
+  WriteInputs(w, options, run.inputs);
+  w.Key("output")
+      .BeginObject()
+      .Field("dir", options.out_dir)
+      .Field("epochs", run.output_epochs)
+      .Field("output_rate_hz", run.output_rate_hz)
+      .EndObject();
+  if (!options.truth.empty()) w.Field("truth", options.truth);
+  w.Key("methods").BeginObject();
+  for (const MethodRun& m : run.methods) {
+    w.Key(m.name).BeginObject().Field("run_time_s", m.solution.run_time_s).Field("knots", m.solution.epochs.size());
+    w.Key("counts").BeginObject();
+    for (const auto& [key, count] : m.solution.counts) {
+      w.Key(key).BeginObject().Field("used", count.used).Field("rejected", count.rejected).EndObject();
+    }
+    w.EndObject();
+    if (!m.solution.solver_report.empty()) w.Field("solver_report", m.solution.solver_report);
+    if (m.errors) {
+      w.Key("errors");
+      WriteScore(w, *m.errors);
+    }
+    w.EndObject();
+  }
+  w.EndObject();
+  w.Field("total_run_time_s", run.total_run_time_s);
+  w.EndObject();
+}
+
+std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
+  const InputSummary& in = run.inputs;
+  std::string s;
+  Append(&s,
+         "%s: %zu IMU samples, %zu GNSS epochs (%zu removed by %zu injected outages), %zu mag, %zu baro; "
+         "%.1f .. %.1f s\n",
+         options.command.c_str(), in.imu_samples, in.gnss_epochs, in.gnss_removed_by_outages, in.outages.size(),
+         in.mag_samples, in.baro_samples, in.t_start_s, in.t_end_s);
+  Append(&s, "solution (%s): %s/{nav.nav, nav.csv, std.csv, imu_errors.csv, summary.json}, %zu epochs\n",
+         run.output_method.c_str(), options.out_dir.c_str(), run.output_epochs);
+  const bool scored = !run.methods.empty() && run.methods.front().errors.has_value();
+  if (!scored) {
+    Append(&s, "%-7s %9s %9s\n", "method", "knots", "run [s]");
+    for (const MethodRun& m : run.methods) {
+      Append(&s, "%-7s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
+    }
+    return s;
+  }
+  const ScoreReport& first = *run.methods.front().errors;
+  const bool outages = !first.outages.empty();
+  Append(&s, "errors against %s (RMS over %zu reference epochs%s):\n", options.truth.c_str(), first.all.count(),
+         outages ? "; drift = per-outage max, RMS over outages" : "");
+  Append(&s, "%-7s %10s %10s %10s %10s %10s %10s", "method", "horiz [m]", "vert [m]", "vel [m/s]", "roll [deg]",
+         "pitch[deg]", "yaw [deg]");
+  if (outages) Append(&s, " %10s %10s", "drift H[m]", "drift V[m]");
+  Append(&s, " %10s\n", "run [s]");
+  for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
+  return s;
+}
+
+DemoFiles SimulateDemo(const std::string& scenario_name, std::uint64_t seed, const std::string& mag_mode,
+                       const std::string& sim_dir, std::ostream* progress) {
+  struct stat st;
+  const bool exists = ::stat(sim_dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+  if (!exists && ::mkdir(sim_dir.c_str(), 0755) != 0) throw std::runtime_error("cannot create " + sim_dir);
+  const sim::Scenario scenario = sim::LoadScenario(scenario_name);
+  if (!scenario.gnss) throw std::runtime_error("the demo scenario " + scenario_name + " has no GNSS");
+  sim::SimulationOptions options;
+  options.seed = seed;
+  if (progress) {
+    options.progress = [progress, &scenario_name](double fraction) {
+      char line[256];
+      std::snprintf(line, sizeof line, "\rsimulating %s %3.0f %%", scenario_name.c_str(), 100.0 * fraction);
+      *progress << line << (fraction >= 1.0 ? "\n" : "") << std::flush;
+    };
+  }
+  sim::Simulate(scenario, options, sim_dir);
+  const std::string yaml = ConfigYamlForSimulation(scenario, sim_dir, seed, mag_mode);
+  DemoFiles f;
+  f.config = sim_dir + "/navtwin.yaml";
+  AtomicFile file(f.config);
+  file.stream() << yaml;
+  file.Commit();
+  f.imu = sim_dir + "/imu.txt";
+  f.gnss = sim_dir + "/gnss.txt";
+  if (scenario.mag && mag_mode != "off") f.mag = sim_dir + "/mag.csv";
+  f.truth = sim_dir + "/truth.nav";
+  return f;
+}
+
+}  // namespace navtwin::gnss_ins
