@@ -26,12 +26,13 @@
 #include "problems/gnss_ins/run.h"
 
 DEFINE_string(kfgins_config, "", "KF-GINS YAML configuration, taken unchanged (its imupath, gnsspath, outputpath are used when --imu, --gnss, --out are not given)");
+DEFINE_string(obgins_config, "", "OB_GINS YAML configuration, taken unchanged (its imufile, gnssfile, outputpath are used when --imu, --gnss, --out are not given; with odometer.isuseodo the IMU file's odometer column and the NHC)");
 DEFINE_string(smoother, "", "navigate: rts = write the RTS-smoothed solution instead of the filter's");
 DEFINE_double(outage_start_s, NAN, "Injected GNSS outages for scoring: first outage start, s after the first IMU epoch");
 DEFINE_double(outage_len_s, 0.0, "Injected GNSS outages: length of each, s");
 DEFINE_double(outage_period_s, 0.0, "Injected GNSS outages: period, s (0: a single outage)");
 DEFINE_string(demo_scenario, "mems-gps-mag-maneuver", "smooth --demo: the simulated scenario (a preset name or a scenario YAML)");
-DEFINE_bool(nhc, false, "Ground vehicles: the non-holonomic constraint (no lateral or vertical velocity of the vehicle reference point), on top of --config or --kfgins_config");
+DEFINE_bool(nhc, false, "Ground vehicles: the non-holonomic constraint (no lateral or vertical velocity of the vehicle reference point), on top of --config, --kfgins_config or --obgins_config");
 DEFINE_double(nhc_sigma_mps, NAN, "Sigma of the non-holonomic constraint, m/s (default: the configuration's nhc.std_mps, 0.1)");
 DEFINE_string(odometer, "", "Wheel-odometer file (t_s,speed_mps or t_s,distance_m): the forward speed of the vehicle reference point, its scale factor estimated (default: the configuration's odometer.file)");
 DEFINE_string(vehicle_mounting_rpy_deg, "", "Roll,pitch,yaw of the IMU (body) axes in the vehicle frame, deg, e.g. 0,0,1.5 (default: the configuration's vehicle.mounting_rpy_deg)");
@@ -120,7 +121,7 @@ std::string ApplyVehicleFlags(GnssInsConfig* config) {
 }
 
 struct Files {
-  std::string imu, gnss, mag, baro, config, kfgins_config, truth, out;
+  std::string imu, gnss, mag, baro, config, kfgins_config, obgins_config, truth, out;
 };
 
 struct Options {
@@ -133,12 +134,13 @@ std::string CheckFlags(const Options& opt, const Files& files) {
   const bool smooth = opt.command == "smooth";
   if (FLAGS_demo) {
     if (!files.imu.empty() || !files.gnss.empty() || !files.mag.empty() || !files.baro.empty() ||
-        !files.config.empty() || !files.kfgins_config.empty() || !files.truth.empty()) {
+        !files.config.empty() || !files.kfgins_config.empty() || !files.obgins_config.empty() ||
+        !files.truth.empty()) {
       return "--demo makes its own --imu, --gnss, --mag, --config and --truth";
     }
     if (files.out.empty()) return "--out is required";
-  } else if (files.config.empty() == files.kfgins_config.empty()) {
-    return "give exactly one of --config YAML and --kfgins_config YAML";
+  } else if (files.config.empty() + files.kfgins_config.empty() + files.obgins_config.empty() != 2) {
+    return "give exactly one of --config YAML, --kfgins_config YAML and --obgins_config YAML";
   }
   if (!smooth && !FLAGS_smoother.empty() && FLAGS_smoother != "rts") return "--smoother must be rts (or absent)";
   if (FLAGS_output_rate_hz < 0.0) return "--output_rate_hz must be >= 0";
@@ -162,7 +164,12 @@ std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* confi
   if (!files->config.empty()) {
     *config = gnss_ins::LoadGnssInsConfig(files->config);
   } else {
-    *config = gnss_ins::LoadKfginsConfig(files->kfgins_config);
+    *config = files->kfgins_config.empty() ? gnss_ins::LoadObginsConfig(files->obgins_config)
+                                           : gnss_ins::LoadKfginsConfig(files->kfgins_config);
+    // OB_GINS' odometer is a column of its IMU file: it follows --imu.
+    if (!config->odometer.file.empty() && config->odometer.file == config->imu_path && !files->imu.empty()) {
+      config->odometer.file = files->imu;
+    }
     if (files->imu.empty()) files->imu = config->imu_path;
     if (files->gnss.empty()) files->gnss = config->gnss_path;
     if (files->out.empty()) files->out = config->output_path;
@@ -208,7 +215,8 @@ gnss_ins::RunMethods MethodsFromFlags(const Options& opt) {
 int Run(const Options& opt, const std::vector<std::string>& args) {
   const auto usage = [&](const std::string& why) { return Usage(opt.command, why, opt.usage); };
   if (!args.empty()) return usage("unexpected argument '" + args[0] + "'");
-  Files files{FLAGS_imu, FLAGS_gnss, FLAGS_mag, FLAGS_baro, FLAGS_config, FLAGS_kfgins_config, FLAGS_truth, FLAGS_out};
+  Files files{FLAGS_imu,           FLAGS_gnss,          FLAGS_mag,   FLAGS_baro, FLAGS_config,
+              FLAGS_kfgins_config, FLAGS_obgins_config, FLAGS_truth, FLAGS_out};
   const std::string flag_error = CheckFlags(opt, files);
   if (!flag_error.empty()) return usage(flag_error);
 
@@ -235,7 +243,8 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
   run_options.paths = {files.imu, files.gnss, files.mag, files.baro, FLAGS_calibration, FLAGS_imu_temperature_degC};
   run_options.truth = files.truth;
   run_options.out_dir = files.out;
-  run_options.config_path = files.config.empty() ? files.kfgins_config : files.config;
+  run_options.config_path =
+      !files.config.empty() ? files.config : (!files.kfgins_config.empty() ? files.kfgins_config : files.obgins_config);
   run_options.command = opt.command;
   run_options.methods = MethodsFromFlags(opt);
   run_options.progress = &std::cerr;
@@ -252,13 +261,13 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
 }
 
 const char* const kNavigateUsage =
-    "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
+    "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--format=json]";
 const char* const kSmoothUsage =
-    "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML) "
+    "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
@@ -274,7 +283,7 @@ Command NavigateCommand() {
   return {"navigate",
           "GNSS/INS/magnetometer error-state Kalman filter (and RTS smoother) over a record",
           kNavigateUsage,
-          {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "smoother", "truth",
+          {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "smoother", "truth",
            "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
            "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps", "odometer", "vehicle_mounting_rpy_deg",
            "vehicle_lever_arm_b_m"},
@@ -285,7 +294,7 @@ Command SmoothCommand() {
   return {"smooth",
           "Filter, RTS and full-batch Ceres smoother over a record; prints the comparison table",
           kSmoothUsage,
-          {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "out", "truth", "output_rate_hz",
+          {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "truth", "output_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
            "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps",
            "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m"},

@@ -93,7 +93,7 @@ Eigen::Vector3d Sigmas(const Rows& rows, std::size_t first, const char* x, const
 
 class KfginsImuReader final : public ImuReader {
  public:
-  explicit KfginsImuReader(const std::string& path) : rows_(path, {7}) {}
+  explicit KfginsImuReader(const std::string& path) : rows_(path, {7, 8}) {}
 
   bool Next(ImuSample* sample) override {
     while (rows_.Next()) {
@@ -202,6 +202,24 @@ void AddTriple(TextLine& line, const Eigen::Vector3d& v) {
 }
 
 }  // namespace
+
+std::vector<OdometerSample> ReadKfginsImuOdometer(const std::string& path) {
+  Rows rows(path, {7, 8});
+  IncreasingTime time;
+  std::vector<OdometerSample> out;
+  while (rows.Next()) {
+    if (rows.size() != 8) {
+      throw InputError(path, rows.line(), "odo", "an IMU file with 7 columns has no odometer column (OB_GINS: 8)");
+    }
+    OdometerSample s;
+    s.t_s = rows.Get(0, "t");
+    time.Check(s.t_s, path, rows.line(), "t");
+    s.speed_mps = rows.Get(7, "odo");
+    out.push_back(s);
+  }
+  if (out.empty()) rows.ThrowEmpty();
+  return out;
+}
 
 std::unique_ptr<ImuReader> OpenKfginsImu(const std::string& path) {
   return std::make_unique<KfginsImuReader>(path);

@@ -4,6 +4,8 @@
 //   IMU   t dtheta_x dtheta_y dtheta_z dv_x dv_y dv_z        (s, rad, m/s; IMU axes, FRD)
 //         increments over (t_{k-1}, t_k]; dt from the time tags; the FIRST sample's dt is
 //         the second sample's interval (one-sample look-ahead), so a file needs 2 lines.
+//         ... odo                                             (8 columns, OB_GINS: + the
+//         odometer's forward speed at t, m/s; the IMU reader ignores it)
 //   GNSS  t lat lon h sigma_n sigma_e sigma_d                 (7 columns: s, deg, deg, m, m)
 //         ... v_n v_e v_d sigma_vn sigma_ve sigma_vd          (13 columns: + m/s)
 //   NAV   week sow lat lon h v_n v_e v_d roll pitch yaw       (11 columns: deg, m, m/s, deg)
@@ -15,8 +17,10 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/io/atomic_file.h"
+#include "core/io/csv_odometer.h"
 #include "core/io/sample_reader.h"
 
 namespace navtwin {
@@ -24,6 +28,10 @@ namespace navtwin {
 std::unique_ptr<ImuReader> OpenKfginsImu(const std::string& path);
 std::unique_ptr<GnssReader> OpenKfginsGnss(const std::string& path);
 std::unique_ptr<NavReader> OpenKfginsNav(const std::string& path);
+
+/// The odometer column of an 8-column (OB_GINS) IMU file: {t, speed_mps} per line, in
+/// time order. An IMU file without it is an InputError naming the file.
+std::vector<OdometerSample> ReadKfginsImuOdometer(const std::string& path);
 
 /// Writes the KF-GINS IMU format with 17 significant digits (doubles round-trip exactly).
 /// Nothing appears at `path` until Commit() (see AtomicFile).

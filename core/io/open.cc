@@ -90,6 +90,8 @@ FileFormat FromNumbers(const std::string& path, const std::vector<std::string_vi
       return std::max(std::fabs(v[1]), std::fabs(v[2])) > kDegreesNotIncrement
                  ? FileFormat::kKfginsGnss
                  : FileFormat::kKfginsImu;
+    case 8:  // OB_GINS: an IMU with the odometer speed
+      return FileFormat::kKfginsImu;
     case 11:
       return v[0] > kEpochSecondsThreshold ? FileFormat::kRtklibWalkImuSf : FileFormat::kKfginsNav;
     case 13:
@@ -249,6 +251,11 @@ std::unique_ptr<NavReader> OpenNav(const std::string& path) {
     default:
       Refuse(path, "navigation states", format);
   }
+}
+
+std::vector<OdometerSample> ReadOdometer(const std::string& path) {
+  if (DetectFormat(path) == FileFormat::kKfginsImu) return ReadKfginsImuOdometer(path);
+  return ReadOdometerCsv(path);
 }
 
 std::unique_ptr<MagReader> OpenMag(const std::string& path) {

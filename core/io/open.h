@@ -4,7 +4,9 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "core/io/csv_odometer.h"
 #include "core/io/file_summary.h"
 #include "core/io/sample_reader.h"
 
@@ -47,6 +49,9 @@ std::unique_ptr<GnssReader> OpenGnss(const std::string& path);
 std::unique_ptr<NavReader> OpenNav(const std::string& path);
 /// navtwin CSV magnetometer files, raw Xsens DOT files with Mag columns, and ULog.
 std::unique_ptr<MagReader> OpenMag(const std::string& path);
+/// Wheel-odometer speeds: navtwin CSV (t_s,speed_mps or t_s,distance_m) or the 8th column
+/// of an OB_GINS IMU file.
+std::vector<OdometerSample> ReadOdometer(const std::string& path);
 /// navtwin CSV barometer files and ULog.
 std::unique_ptr<BaroReader> OpenBaro(const std::string& path);
 

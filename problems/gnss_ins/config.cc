@@ -489,6 +489,77 @@ void CrossCheckRate(const std::string& config_path, long line, const std::string
   }
 }
 
+/// Keys of a foreign configuration that navtwin does not read, listed on stderr.
+void WarnUnused(const std::string& path, const YAML::Node& y, std::initializer_list<const char*> known) {
+  std::string ignored;
+  for (const auto& kv : y) {
+    const std::string key = kv.first.as<std::string>();
+    if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) == known.end()) {
+      ignored += (ignored.empty() ? "" : ", ") + key + " (line " + std::to_string(kv.first.Mark().line + 1) + ")";
+    }
+  }
+  if (!ignored.empty()) {
+    std::cerr << "warning: " << path << ": keys navtwin does not use (ignored): " << ignored << "\n";
+  }
+}
+
+/// OB_GINS imumodel {arw [deg/sqrt(h)], vrw [m/s/sqrt(h)], gbstd [deg/h], abstd [mGal],
+/// corrtime [h]}: biases only (OB_GINS estimates no scale factors).
+ImuNoise ObginsNoise(const ConfigNode& root) {
+  if (!root.Has("imumodel")) root.Fail("imumodel", "required (OB_GINS configuration)");
+  const ConfigNode m = root.Child("imumodel");
+  m.RequireKeys({"arw", "vrw", "gbstd", "abstd", "corrtime"});
+  for (const char* key : {"arw", "vrw", "gbstd", "abstd", "corrtime"}) {
+    if (!m.Has(key)) m.Fail(key, "required (OB_GINS configuration)");
+  }
+  ImuNoise n;
+  n.gyro_arw_rad_per_sqrt_s = Sigma(m, "arw", 1.0) * kDegSqrtHToRadSqrtS;
+  n.accel_vrw_mps_per_sqrt_s = Sigma(m, "vrw", 1.0) / 60.0;
+  n.gyro_bias_std_radps = Sigma(m, "gbstd", 1.0) * kDegHToRadps;
+  n.accel_bias_std_mps2 = Sigma(m, "abstd", 1.0) * kMgalToMps2;
+  n.correlation_time_s = Sigma(m, "corrtime", 1.0) * 3600.0;
+  return n;
+}
+
+/// OB_GINS initialisation: velocity and attitude given, the position from the first GNSS
+/// fix at or after starttime. OB_GINS gives no initial sigmas; navtwin takes these.
+void ObginsInit(const ConfigNode& root, GnssInsConfig* c) {
+  const Eigen::Vector3d vel = KfVector(root, "initvel", true);
+  const Eigen::Vector3d att = KfVector(root, "initatt", true);
+  InsState s;
+  s.nav.t_s = c->start_time_s;
+  s.nav.v_n_mps = vel;
+  s.nav.q_n_b = QuatFromEuler(att[0] * kDegToRad, att[1] * kDegToRad, att[2] * kDegToRad);
+  c->init.source = InitConfig::Source::kGiven;
+  c->init.position_from_gnss = true;
+  c->init.imu_errors.bg_radps = KfVector(root, "initgb", false) * kDegHToRadps;
+  c->init.imu_errors.ba_mps2 = KfVector(root, "initab", false) * kMgalToMps2;
+  s.imu = c->init.imu_errors;
+  c->init.state = s;
+  c->init.std.pos_ned_m = Eigen::Vector3d::Constant(1.0);
+  c->init.std.vel_ned_mps = Eigen::Vector3d::Constant(0.5);
+  c->init.std.att_rad = Eigen::Vector3d(1.0, 1.0, 5.0) * kDegToRad;
+}
+
+/// OB_GINS odometer {isuseodo, std [m/s] (forward, lateral, vertical), srw [ppm]}, odolever,
+/// bodyangle: the odometer column of the IMU file and the NHC.
+void ObginsVehicle(const ConfigNode& root, GnssInsConfig* c) {
+  c->vehicle.lever_arm_b_m = KfVector(root, "odolever", false);
+  c->vehicle.mounting_rpy_rad = KfVector(root, "bodyangle", false) * kDegToRad;
+  const ConfigNode odo = root.Child("odometer");
+  odo.RequireKeys({"isuseodo", "std", "srw"});
+  if (!odo.Bool("isuseodo", false)) return;
+  if (root.Int("imudatalen", 7, 7, 1000) < 8) {
+    root.Fail("imudatalen", "odometer.isuseodo needs the odometer column: imudatalen 8 or more");
+  }
+  const Eigen::Vector3d std = KfSigmaVector(odo, "std", true);
+  c->odometer.file = c->imu_path;
+  c->odometer.std_mps = std[0];
+  c->odometer.scale_std = odo.NonNegative("srw", 100.0) * kPpm;
+  c->nhc.enabled = true;
+  c->nhc.std_mps = std::max(std[1], std[2]);
+}
+
 }  // namespace
 
 GnssInsConfig LoadGnssInsConfig(const std::string& path) {
@@ -622,6 +693,39 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
     const double rate = root.Double("imudatarate", 0.0);
     if (!(rate > 0.0)) root.Fail("imudatarate", "must be > 0 (Hz)");
     if (!c.imu_path.empty()) CrossCheckRate(path, KeyLine(y, "imudatarate"), c.imu_path, rate);
+  }
+  return c;
+}
+
+GnssInsConfig LoadObginsConfig(const std::string& path) {
+  const ConfigNode root = sim::LoadYamlFile(path);
+  const YAML::Node& y = root.yaml();
+  if (!y.IsMap()) root.Fail("", "expected a mapping of keys to values (an OB_GINS configuration)");
+  WarnUnused(path, y, {"imufile", "gnssfile", "outputpath", "starttime", "endtime", "initvel", "initatt", "initgb",
+                       "initab", "imudatalen", "imudatarate", "antlever", "odolever", "bodyangle", "odometer",
+                       "imumodel", "isuseoutage", "outagetime", "outagelen", "outageperiod"});
+  GnssInsConfig c;
+  // Relative paths are taken relative to the current directory, as OB_GINS does.
+  c.imu_path = root.String("imufile", "");
+  c.gnss_path = root.String("gnssfile", "");
+  c.output_path = root.String("outputpath", "");
+  for (const char* key : {"starttime", "endtime"}) {
+    if (!root.Has(key)) root.Fail(key, "required (OB_GINS configuration)");
+  }
+  c.start_time_s = root.Double("starttime", 0.0);
+  const double end = root.Double("endtime", -1.0);
+  c.end_time_s = end <= 0.0 ? kInf : end;  // OB_GINS: 0 or -1 = to the end of the IMU file
+  if (!(c.end_time_s > c.start_time_s)) root.Fail("endtime", "must be after starttime (or 0 / -1)");
+  ObginsInit(root, &c);
+  c.imu_noise = ObginsNoise(root);
+  c.installation.antenna_lever_arm_b_m = KfVector(root, "antlever", true);
+  ObginsVehicle(root, &c);
+  if (root.Bool("isuseoutage", false)) {
+    // OB_GINS gives the first outage in GPS seconds; navtwin counts from the start.
+    c.outages.start_s = root.Double("outagetime", c.start_time_s) - c.start_time_s;
+    c.outages.len_s = root.Positive("outagelen", 60.0);
+    c.outages.period_s = root.NonNegative("outageperiod", 0.0);
+    if (c.outages.start_s < 0.0) root.Fail("outagetime", "must be at or after starttime");
   }
   return c;
 }

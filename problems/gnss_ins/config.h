@@ -58,6 +58,9 @@ struct InitConfig {
   };
   Source source = Source::kGiven;
   std::optional<InsState> state;  ///< required for kGiven (time = start)
+  /// kGiven: the position (and the start) from the first GNSS fix at or after the state's
+  /// time, velocity and attitude from `state` (OB_GINS starts so).
+  bool position_from_gnss = false;
   double static_duration_s = 60.0;
   Heading heading = Heading::kAuto;
   int heading_hypotheses = 8;      ///< kSearch: headings k 360 deg / heading_hypotheses
@@ -131,5 +134,14 @@ GnssInsConfig LoadGnssInsConfig(const std::string& path);
 /// vrw [m/s/sqrt(h)], gbstd [deg/h], abstd [mGal], gsstd [ppm], asstd [ppm], corrtime [h]},
 /// antlever [m]). Relative paths are taken relative to the current directory, as KF-GINS does.
 GnssInsConfig LoadKfginsConfig(const std::string& path);
+
+/// Reads an OB_GINS YAML configuration unchanged (imufile, gnssfile, outputpath, starttime,
+/// endtime, initvel [m/s], initatt [deg], initgb [deg/h], initab [mGal], imudatalen,
+/// imudatarate, antlever, odolever, bodyangle [deg] (C_b^v), odometer {isuseodo, std [m/s],
+/// srw [ppm]}, imumodel {arw, vrw, gbstd, abstd, corrtime}, isuseoutage, outagetime,
+/// outagelen, outageperiod; windows, isearth and gnssthreshold are listed as not used).
+/// The position comes from the first GNSS fix at or after starttime, as in OB_GINS; with
+/// isuseodo the odometer column of the 8-column IMU file and the NHC are used.
+GnssInsConfig LoadObginsConfig(const std::string& path);
 
 }  // namespace navtwin::gnss_ins

@@ -43,6 +43,24 @@ bool AnyNonZero(const ImuErrors& e) {
   return !e.bg_radps.isZero(0.0) || !e.ba_mps2.isZero(0.0) || !e.sg.isZero(0.0) || !e.sa.isZero(0.0);
 }
 
+/// The position and the start from the first GNSS fix at or after the start (which made
+/// the state: its measurements are skipped).
+void PositionFromFirstFix(const Inputs& inputs, const GnssInsConfig& config, FilterStart* start) {
+  NavState& nav = start->state.nav;
+  const auto fix = std::find_if(inputs.gnss.begin(), inputs.gnss.end(), [&](const GnssSample& g) {
+    return g.t_s >= nav.t_s - kTimeEps_s && g.t_s < inputs.imu.back().t_s;
+  });
+  if (fix == inputs.gnss.end()) {
+    throw InputError(inputs.paths.gnss, 0, "position",
+                     "the initial position comes from the first GNSS fix at or after " + Seconds(nav.t_s) +
+                         ", and the IMU record has none after it");
+  }
+  ins::ImuPositionFromAntenna(*fix, nav.q_n_b, config.installation.antenna_lever_arm_b_m, &nav);
+  nav.t_s = fix->t_s;
+  nav.gps_week = fix->gps_week;
+  start->use_measurements_at_start = false;
+}
+
 FilterStart GivenStart(const Inputs& inputs, const GnssInsConfig& config) {
   if (!config.init.state) {
     throw std::invalid_argument("RunFilter: init.source given needs init.state");
@@ -55,6 +73,7 @@ FilterStart GivenStart(const Inputs& inputs, const GnssInsConfig& config) {
   // starttime before the first IMU sample).
   if (start.state.nav.t_s < imu_begin_s) start.state.nav.t_s = imu_begin_s;
   start.use_measurements_at_start = true;
+  if (config.init.position_from_gnss) PositionFromFirstFix(inputs, config, &start);
   return start;
 }
 

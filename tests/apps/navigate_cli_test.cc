@@ -195,6 +195,52 @@ TEST(NavigateCli, RunsAKfginsConfigurationUnchanged) {
   EXPECT_NE(ReadAll(r.dir + "/kf_out/imu_errors.csv").find("sa_z_ppm"), std::string::npos);
 }
 
+// OB_GINS users bring their files unchanged: its YAML configuration, and its IMU text with
+// the odometer speed as an 8th column (read as IMU + odometer; with isuseodo the NHC too).
+TEST(NavigateCli, RunsAnObginsConfigurationWithItsOdometerColumn) {
+  const Record r = WriteRecord("obgins");
+  const std::string imu8 = r.dir + "/imu_odo.txt";
+  {
+    std::ofstream out(imu8);
+    for (int k = 1; k <= kImuSamples; ++k) {
+      std::string line = ImuLine(k);
+      line.pop_back();
+      out << line << " 0.0\n";  // standing: odometer speed 0
+    }
+  }
+  const std::string ob = r.dir + "/ob_gins.yaml";
+  std::ofstream(ob) << "imufile: \"" << imu8 << "\"\ngnssfile: \"" << r.gnss << "\"\noutputpath: \"" << r.dir
+                    << "/ob_out\"\nwindows: 20\nstarttime: 0\nendtime: 0\ninitvel: [0, 0, 0]\ninitatt: [0, 0, 0]\n"
+                       "initgb: [0, 0, 0]\ninitab: [0, 0, 0]\nimudatalen: 8\nimudatarate: 100\nisearth: true\n"
+                       "antlever: [0, 0, 0]\nodolever: [0, 0, 0]\nbodyangle: [0, 0, 0]\n"
+                       "odometer:\n    isuseodo: true\n    std: [0.05, 0.05, 0.05]\n    srw: 100\n"
+                       "imumodel:\n    arw: 0.2\n    vrw: 0.1\n    gbstd: 10.0\n    abstd: 1000.0\n    corrtime: 1.0\n"
+                       "isuseoutage: false\noutagetime: 0\noutagelen: 60\noutageperiod: 180\ngnssthreshold: 20.0\n";
+  const RunResult run = Navtwin("navigate --obgins_config " + ob + " --format=json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("windows (line 5)"), std::string::npos) << run.err;  // listed as not used
+  EXPECT_TRUE(Exists(r.dir + "/ob_out/nav.nav"));
+  // The odometer column is used from the first fix on (19 s at 100 Hz, minus the start).
+  const double odometer_used = JsonNumberAfter(run.out, "\"odometer\":", "used");
+  EXPECT_GT(odometer_used, 1800.0) << run.out;
+  // A 7-column IMU file has no odometer column: named with file, line and field.
+  const RunResult no_column = Navtwin("navigate --obgins_config " + ob + " --imu " + r.imu + " --out " + r.dir + "/o7");
+  EXPECT_EQ(no_column.exit_code, 1);
+  EXPECT_NE(no_column.err.find(r.imu), std::string::npos) << no_column.err;
+  EXPECT_NE(no_column.err.find("odo"), std::string::npos) << no_column.err;
+}
+
+TEST(NavigateCli, VehicleFlagsRejectBadValues) {
+  const Record r = WriteRecord("vehicle_flags");
+  for (const std::string bad : {"--nhc_sigma_mps -1", "--vehicle_lever_arm_b_m 1,2",
+                                "--vehicle_mounting_rpy_deg 0,0,x", "--vehicle_lever_arm_b_m 1,2,3,4"}) {
+    const RunResult run = Navtwin("navigate " + Args(r, r.dir + "/out") + " --nhc " + bad);
+    EXPECT_EQ(run.exit_code, 2) << bad << ": " << run.err;
+  }
+  const RunResult ok = Navtwin("navigate " + Args(r, r.dir + "/ok") + " --nhc --vehicle_lever_arm_b_m=-1.2,0,0.3");
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
 /// Runs `navigate` on a bad record: exit 1, every part in the message, nothing in --out.
 void ExpectBadInput(const Record& r, const std::vector<std::string>& parts) {
   const std::string out = r.dir + "/out";

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/io/csv_odometer.h"
+#include "core/io/open.h"
 #include "core/rotation.h"
 #include "factors/odometer_speed.h"
 #include "problems/ins/association.h"
@@ -20,7 +20,7 @@ class OdometerSource : public AidingSource {
         lever_b_m_(vehicle.lever_arm_b_m),
         R_v_b_(DcmFromEuler<double>(vehicle.mounting_rpy_rad[0], vehicle.mounting_rpy_rad[1],
                                     vehicle.mounting_rpy_rad[2])),
-        samples_(ReadOdometerCsv(config.file)) {
+        samples_(ReadOdometer(config.file)) {
     times_.reserve(samples_.size());
     for (const OdometerSample& s : samples_) times_.push_back(s.t_s);
   }

@@ -14,7 +14,9 @@
 namespace navtwin::ins {
 
 struct OdometerConfig {
-  std::string file;         ///< t_s,speed_mps or t_s,distance_m (core/io/csv_odometer.h); empty: off
+  /// t_s,speed_mps or t_s,distance_m (core/io/csv_odometer.h), or an OB_GINS IMU file
+  /// with the odometer column (core/io/kfgins.h); empty: off.
+  std::string file;
   double std_mps = 0.1;     ///< speed noise
   double scale_std = 0.01;  ///< prior std of the scale-factor error (0: held at 0)
 };

@@ -72,6 +72,24 @@ TEST(KfginsTest, ReadsKfginsStyleWhitespaceAndCommas) {
   EXPECT_EQ(out[2].dv_b_mps.z(), -0.049);
 }
 
+// OB_GINS writes the odometer speed as an 8th column of its IMU file: the IMU reader reads
+// the increments, ReadOdometer the speeds; a 7-column file has no odometer column.
+TEST(KfginsTest, ObginsEighthColumnIsTheOdometer) {
+  const std::string path = WriteTempFile("imu_odo.txt", "100.00 1e-4 0 0 0 0 -0.098 3.5\n100.01 1e-4 0 0 0 0 -0.098 3.25\n");
+  EXPECT_EQ(DetectFormat(path), FileFormat::kKfginsImu);
+  const std::vector<ImuSample> imu = ReadAllSamples(*OpenImu(path));
+  ASSERT_EQ(imu.size(), 2u);
+  EXPECT_EQ(imu[1].dv_b_mps.z(), -0.098);
+  const std::vector<OdometerSample> odo = ReadOdometer(path);
+  ASSERT_EQ(odo.size(), 2u);
+  EXPECT_EQ(odo[0].t_s, 100.0);
+  EXPECT_EQ(odo[1].speed_mps, 3.25);
+  const std::string seven = WriteTempFile("imu7.txt", "100.00 1e-4 0 0 0 0 -0.098\n100.01 1e-4 0 0 0 0 -0.098\n");
+  ExpectInputError([&] { ReadOdometer(seven); }, {seven, "line 1", "odo", "no odometer column"});
+  const std::string nan = WriteTempFile("imu_nan.txt", "100.00 1e-4 0 0 0 0 -0.098 nan\n");
+  ExpectInputError([&] { ReadOdometer(nan); }, {nan, "line 1", "odo", "not a finite number"});
+}
+
 TEST(KfginsTest, GnssRoundTripWithAndWithoutVelocity) {
   for (bool velocity : {false, true}) {
     std::vector<GnssSample> in(20);

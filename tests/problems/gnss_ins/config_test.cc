@@ -333,6 +333,83 @@ TEST(KfginsConfig, ExtraKeysAreListedInAWarning) {
   EXPECT_EQ(c.start_time_s, 456300.0);
 }
 
+// An OB_GINS configuration (its keys and units as OB_GINS writes them).
+const char* const kObgins = R"(imufile: "./imu_odo.txt"
+gnssfile: "./GNSS_RTK.pos"
+outputpath: "./ob_out"
+windows: 20
+starttime: 357900
+endtime: 359090
+initvel: [ 0, 0, 0 ]
+initatt: [ 0.5, -1.0, 185.0 ]
+initgb: [ 0, 0, 36 ]
+initab: [ 0, 100, 0 ]
+imudatalen: 8
+imudatarate: 200
+isearth: true
+antlever: [ -0.073, 0.302, 0.087 ]
+odolever: [ -0.522, -0.47, 1.797 ]
+bodyangle: [ 0, -0.2, 1.2 ]
+odometer:
+    isuseodo: true
+    std: [ 0.05, 0.1, 0.2 ]
+    srw: 100
+imumodel:
+    arw: 0.24
+    vrw: 0.24
+    gbstd: 50.0
+    abstd: 250.0
+    corrtime: 1.0
+isuseoutage: true
+outagetime: 358000
+outagelen: 60
+outageperiod: 180
+gnssthreshold: 20.0
+)";
+
+TEST(ObginsConfig, ReadsUnitsOfObgins) {
+  ::testing::internal::CaptureStderr();
+  const GnssInsConfig c = LoadObginsConfig(WriteTempFile("ob.yaml", kObgins));
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("windows (line 4)"), std::string::npos) << err;
+  EXPECT_NE(err.find("gnssthreshold (line 31)"), std::string::npos) << err;
+  EXPECT_EQ(c.imu_path, "./imu_odo.txt");
+  EXPECT_EQ(c.start_time_s, 357900.0);
+  EXPECT_EQ(c.end_time_s, 359090.0);
+  ASSERT_TRUE(c.init.state.has_value());
+  EXPECT_TRUE(c.init.position_from_gnss);  // OB_GINS takes the position from GNSS
+  EXPECT_NEAR(EulerFromQuat(c.init.state->nav.q_n_b)[1], -1.0 * kDegToRad, 1e-12);
+  EXPECT_NEAR(c.init.imu_errors.bg_radps.z(), 36.0 * kDegToRad / 3600.0, kRel);
+  EXPECT_NEAR(c.init.imu_errors.ba_mps2.y(), 100e-5, 1e-18);
+  EXPECT_NEAR(c.imu_noise.gyro_arw_rad_per_sqrt_s, 0.24 * kDegToRad / 60.0, 1e-20);
+  EXPECT_NEAR(c.imu_noise.accel_bias_std_mps2, 250e-5, 1e-18);
+  EXPECT_EQ(c.imu_noise.correlation_time_s, 3600.0);
+  EXPECT_FALSE(c.filter.scale_factors);
+  EXPECT_EQ(c.installation.antenna_lever_arm_b_m, Eigen::Vector3d(-0.073, 0.302, 0.087));
+  // The odometer is the IMU file's column, with the NHC; the vehicle from odolever/bodyangle.
+  EXPECT_EQ(c.odometer.file, "./imu_odo.txt");
+  EXPECT_EQ(c.odometer.std_mps, 0.05);
+  EXPECT_NEAR(c.odometer.scale_std, 100e-6, 1e-18);
+  EXPECT_TRUE(c.nhc.enabled);
+  EXPECT_EQ(c.nhc.std_mps, 0.2);
+  EXPECT_EQ(c.vehicle.lever_arm_b_m, Eigen::Vector3d(-0.522, -0.47, 1.797));
+  EXPECT_NEAR(c.vehicle.mounting_rpy_rad.z(), 1.2 * kDegToRad, 1e-15);
+  // Outages: OB_GINS' GPS time of the first one, counted from the start here.
+  EXPECT_EQ(c.outages.start_s, 100.0);
+  EXPECT_EQ(c.outages.len_s, 60.0);
+  EXPECT_EQ(c.outages.period_s, 180.0);
+}
+
+TEST(ObginsConfig, BadValues) {
+  const std::string seven = WriteTempFile("seven.yaml", Replace(kObgins, "imudatalen: 8", "imudatalen: 7"));
+  ExpectInputError([&] { LoadObginsConfig(seven); }, {seven, "imudatalen", "odometer column"});
+  const std::string no_model = WriteTempFile("no_model.yaml", Replace(kObgins, "    corrtime: 1.0", ""));
+  ExpectInputError([&] { LoadObginsConfig(no_model); }, {no_model, "imumodel.corrtime", "required"});
+  const std::string zero_std =
+      WriteTempFile("zero_std.yaml", Replace(kObgins, "std: [ 0.05, 0.1, 0.2 ]", "std: [ 0, 0.1, 0.2 ]"));
+  ExpectInputError([&] { LoadObginsConfig(zero_std); }, {zero_std, "odometer.std", "> 0"});
+}
+
 TEST(KfginsConfig, BadValues) {
   std::string zero = kKfgins;
   zero = Replace(zero, "initposstd: [ 0.005", "initposstd: [ 0.000");
