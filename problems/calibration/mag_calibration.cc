@@ -20,7 +20,7 @@
 #include <Eigen/LU>
 
 #include "core/rotation.h"
-#include "factors/mag_ellipsoid.h"
+#include "problems/calibration/mag_ellipsoid.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -271,7 +271,7 @@ class RobustSandwich {
 }  // namespace
 
 Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector3d& m_uT) {
-  return c.correction * (m_uT - c.hard_iron_uT);
+  return RemoveIron(m_uT, c.hard_iron_uT, c.correction);
 }
 
 // ------------------------------------------------------------------------ batch ellipsoid

@@ -1,7 +1,8 @@
 // Magnetometer calibration (seed 001 section 3, issue 8): hard and soft iron.
 //
-// Sensor model (the simulator's, core/sim/aiding.h): m = (I + S) m_b + h + n, with m_b the
-// Earth field in body axes (|m_b| = B everywhere), S the soft iron, h the hard iron, n noise.
+// Sensor model (core/mag_iron_model.h, as the simulator draws it): m = (I + S) m_b + h + n,
+// with m_b the Earth field in body axes (|m_b| = B everywhere), S the soft iron, h the hard
+// iron, n noise.
 // Calibration: m_b ~ A (m - h), A = (I + S)^-1 up to a rotation; A is estimated SYMMETRIC
 // (6 unknowns: the rotation part of (I + S)^-1 cannot be seen from magnitudes alone and is
 // the IMU-to-magnetometer alignment, not iron), h has 3, and the field magnitude B is fixed
@@ -38,6 +39,7 @@
 
 #include <Eigen/Core>
 
+#include "core/mag_iron_model.h"
 #include "core/types.h"
 
 namespace navtwin::calibration {
