@@ -1,6 +1,5 @@
 // LoadInputs: installation, time cut, IMU gap bridging, outage injection and the bad-input
 // checks (each an InputError naming the file and the line or time).
-#include "problems/gnss_ins/ins_state.h"  // before inputs.h: config.h uses InsState
 #include "problems/gnss_ins/inputs.h"
 
 #include <cmath>

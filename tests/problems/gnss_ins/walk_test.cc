@@ -11,8 +11,6 @@
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
-#include "problems/gnss_ins/ins_state.h"
-// (ins_state.h before config.h)
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/config.h"
 #include "problems/gnss_ins/densify.h"
