@@ -157,12 +157,12 @@ void VibrationModel::Increment(double t0_s, double t1_s, Eigen::Vector3d* dtheta
   }
 }
 
-void VibrationModel::Rate(double t_s, Eigen::Vector3d* omega_rad_s, Eigen::Vector3d* f_mps2) const {
-  omega_rad_s->setZero();
+void VibrationModel::Rate(double t_s, Eigen::Vector3d* omega_radps, Eigen::Vector3d* f_mps2) const {
+  omega_radps->setZero();
   f_mps2->setZero();
   for (const VibrationTone& tone : tones_) {
     const double phase = 2.0 * M_PI * CycleFraction(tone.frequency_hz, t_s) + tone.phase_rad;
-    (tone.angular ? *omega_rad_s : *f_mps2)[tone.axis] += tone.amplitude * std::sin(phase);
+    (tone.angular ? *omega_radps : *f_mps2)[tone.axis] += tone.amplitude * std::sin(phase);
   }
 }
 
