@@ -38,8 +38,8 @@ namespace navtwin::sim {
 struct VibrationToneConfig {
   std::array<bool, 3> axes{{false, false, false}};  ///< body x, y, z (FRD)
   Eigen::Vector2d frequency_hz{0.0, 0.0};           ///< range of the fundamental
-  double linear_g = 0.0;                            ///< specific-force amplitude (g)
-  double angular_deg_s = 0.0;                       ///< angular-rate amplitude (deg/s)
+  double linear_mps2 = 0.0;                         ///< specific-force amplitude (key linear_g)
+  double angular_radps = 0.0;                       ///< angular-rate amplitude (key angular_deg_s)
   bool random_amplitude = true;  ///< amplitudes are 1-sigma of a zero-mean normal draw
   std::vector<double> harmonic_gains{1.0};  ///< relative amplitude of harmonic k = 1..n
 };

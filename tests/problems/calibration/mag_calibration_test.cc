@@ -492,7 +492,7 @@ TEST(FitPlanar, HalfATurnAndASphereAreRefused) {
   EXPECT_THROW(FitPlanar(std::vector<MagSample>(half.samples.begin(), half.samples.begin() + 11)),
                std::invalid_argument);
   PlanarFitOptions bad;
-  bad.min_coverage_deg = 400.0;
+  bad.min_coverage_rad = 400.0 * kDegToRad;
   EXPECT_THROW(FitPlanar(half.samples, bad), std::invalid_argument);
 }
 
