@@ -16,12 +16,11 @@
 #include "core/io/atomic_file.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin {
 namespace {
 
-using sim::ConfigNode;
 using Triad = Eigen::Matrix<double, kTriadParameters, 1>;
 using GSens = Eigen::Matrix<double, kGSensitivityParameters, 1>;
 
@@ -183,14 +182,20 @@ ImuCalibration ParseImu(const ConfigNode& imu) {
 }
 
 MagCorrection ParseMag(const ConfigNode& mag) {
-  mag.RequireKeys({"hard_iron_uT", "soft_iron", "field_uT"});
+  // `soft_iron` is the name files written before the iron model (core/mag_iron_model.h) gave
+  // the correction A; it is read as A, never as the soft iron S.
+  mag.RequireKeys({"hard_iron_uT", "correction", "soft_iron", "field_uT"});
+  if (mag.Has("correction") && mag.Has("soft_iron")) {
+    mag.Fail("soft_iron", "give the correction once (correction, or soft_iron in older files)");
+  }
   MagCorrection m;
   if (mag.Has("hard_iron_uT")) m.hard_iron_uT = Vector3(mag, "hard_iron_uT", false);
-  if (mag.Has("soft_iron")) {
-    m.soft_iron = Matrix3(mag, "soft_iron", false);
-    const double det = m.soft_iron.determinant();
+  const char* key = mag.Has("correction") ? "correction" : "soft_iron";
+  if (mag.Has(key)) {
+    m.correction = Matrix3(mag, key, false);
+    const double det = m.correction.determinant();
     if (!(std::abs(det) >= kMinDeterminant)) {
-      mag.Fail("soft_iron", "not invertible (determinant " + Num(det) + ")");
+      mag.Fail(key, "not invertible (determinant " + Num(det) + ")");
     }
   }
   m.field_uT = mag.NonNegative("field_uT", 0.0);
@@ -314,7 +319,7 @@ ImuCalibration ImuCalibration::At(double temperature_degC) const {
 }
 
 CalibrationFile ReadCalibrationFile(const std::string& path) {
-  const ConfigNode root = sim::LoadYamlFile(path);
+  const ConfigNode root = LoadYamlFile(path);
   root.RequireKeys({"navtwin_calibration", "created_by", "imu", "mag"});
   if (!root.Has("navtwin_calibration")) {
     root.Fail("navtwin_calibration", "required: the file's format version (" + std::to_string(kFileVersion) +
@@ -368,7 +373,7 @@ void WriteCalibrationFile(const std::string& path, const CalibrationFile& file) 
     }
   }
   if (file.mag) {
-    s << "mag:\n  hard_iron_uT: " << Vec(file.mag->hard_iron_uT) << "\n  soft_iron: " << Mat(file.mag->soft_iron)
+    s << "mag:\n  hard_iron_uT: " << Vec(file.mag->hard_iron_uT) << "\n  correction: " << Mat(file.mag->correction)
       << "\n  field_uT: " << Value(file.mag->field_uT) << "\n";
   }
   out.Commit();
@@ -381,7 +386,7 @@ ImuSample ApplyImuCalibration(const ImuCalibration& c, const ImuSample& s) {
 
 MagSample ApplyMagCorrection(const MagCorrection& c, const MagSample& s) {
   MagSample out = s;
-  out.m_b_uT = c.soft_iron * (s.m_b_uT - c.hard_iron_uT);
+  out.m_b_uT = RemoveIron(s.m_b_uT, c.hard_iron_uT, c.correction);
   return out;
 }
 

@@ -16,8 +16,9 @@
 //       accel_bias_mps2:     [[...], ...]
 //       accel_scale_factor:  [[...], ...]
 //   mag:                                  (optional)
-//     hard_iron_uT: [3]
-//     soft_iron: [[3]x3]    the correction A: m_corrected = A (m - hard_iron)
+//     hard_iron_uT: [3]     h
+//     correction: [[3]x3]   A: m_corrected = A (m - h), A = (I + S)^-1 for the soft iron S
+//                           (core/mag_iron_model.h); older files name A `soft_iron`
 //     field_uT: B
 //
 // Any key missing inside a present section means "no error" (zero) for that term.
@@ -32,6 +33,7 @@
 
 #include "core/io/sample_reader.h"
 #include "core/imu_error_model.h"
+#include "core/mag_iron_model.h"
 
 namespace navtwin {
 
@@ -60,9 +62,10 @@ struct ImuCalibration {
   ImuCalibration At(double temperature_degC) const;
 };
 
+/// The iron of core/mag_iron_model.h in the correction form a calibration estimates.
 struct MagCorrection {
-  Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d soft_iron = Eigen::Matrix3d::Identity();  ///< A
+  Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();   ///< h
+  Eigen::Matrix3d correction = Eigen::Matrix3d::Identity();  ///< A = (I + S)^-1
   double field_uT = 0.0;                                    ///< 0: unknown
 };
 
@@ -73,7 +76,7 @@ struct CalibrationFile {
 };
 
 /// Throws InputError naming the file, line and key (unknown keys, wrong sizes, non-finite
-/// values, a non-invertible I + diag(s) + M or soft iron, a missing version).
+/// values, a non-invertible I + diag(s) + M or correction A, a missing version).
 CalibrationFile ReadCalibrationFile(const std::string& path);
 /// Writes atomically (the file appears whole or not at all).
 void WriteCalibrationFile(const std::string& path, const CalibrationFile& file);

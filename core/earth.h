@@ -23,7 +23,7 @@ constexpr double kA_m = 6378137.0;                  ///< semi-major axis [1]
 constexpr double kF = 1.0 / 298.257223563;          ///< flattening [1]
 constexpr double kB_m = kA_m * (1.0 - kF);          ///< semi-minor axis
 constexpr double kE2 = kF * (2.0 - kF);             ///< first eccentricity squared
-constexpr double kOmegaIe_rad_s = 7.292115e-5;      ///< Earth rotation rate [1]
+constexpr double kOmegaIe_radps = 7.292115e-5;      ///< Earth rotation rate [1]
 constexpr double kGM_m3_s2 = 3.986004418e14;        ///< geocentric gravitational constant [1]
 constexpr double kGammaE_mps2 = 9.7803253359;       ///< normal gravity at the equator [1]
 constexpr double kSomiglianaK = 0.00193185265241;   ///< k = (b gamma_p)/(a gamma_e) - 1 [1]
@@ -76,8 +76,8 @@ template <typename T>
 Eigen::Matrix<T, 3, 1> EarthRateNed(const T& lat_rad) {
   using std::cos;
   using std::sin;
-  return Eigen::Matrix<T, 3, 1>(T(kOmegaIe_rad_s) * cos(lat_rad), T(0),
-                                -T(kOmegaIe_rad_s) * sin(lat_rad));
+  return Eigen::Matrix<T, 3, 1>(T(kOmegaIe_radps) * cos(lat_rad), T(0),
+                                -T(kOmegaIe_radps) * sin(lat_rad));
 }
 
 /// Transport rate omega_en_n (rotation of NED over the ellipsoid), rad/s:

@@ -1,8 +1,8 @@
 // The leveling measurement model shared by every leveling method (equation 1 of seed 000):
 // the plain mean and period average (problems/leveling/leveling.cc), the online filter
 // (problems/leveling/filter.cc) and the Ceres residual of the batch
-// (factors/leveling_vibration.*). In core because it is plain math used by factors and
-// problems alike.
+// (problems/leveling/leveling_vibration.*). In core because equation 1 is also the level of
+// other problems (the accelerometer level of problems/calibration/mag_heading).
 // At rest the accelerometers sense f_b = R_b_n (0, 0, -g)^T in body FRD axes, NED frame:
 //   f_b = ( g sin(pitch), -g sin(roll) cos(pitch), -g cos(roll) cos(pitch) )
 // and inversely (the signed atan2 form of equation 1)

@@ -25,6 +25,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "core/units.h"
+
 namespace navtwin {
 
 template <typename T>
@@ -199,15 +201,61 @@ Quaternion<T> ApplyAttitudeError(const Vector3<T>& phi_n, const Quaternion<T>& q
   return q;
 }
 
-/// Wraps an angle to (-pi, pi].
-inline double WrapPi(double a_rad) {
-  const double two_pi = 2.0 * M_PI;
-  double r = std::fmod(a_rad + M_PI, two_pi);
-  if (r <= 0.0) r += two_pi;
-  return r - M_PI;
+/// SO(3) right Jacobian: Exp(phi + d) = Exp(phi) Exp(Jr(phi) d) + O(|d|^2),
+///   Jr(phi) = I - (1 - cos t)/t^2 [phi]x + (t - sin t)/t^3 [phi]x^2,   t = |phi|,
+/// with the series 1/2 - t^2/24 + t^4/720 and 1/6 - t^2/120 + t^4/5040 below t^2 = 1e-8
+/// (truncation < 1e-25). The left Jacobian is Jl(phi) = Jr(-phi).
+template <typename T>
+Matrix3<T> RightJacobianSO3(const Vector3<T>& phi) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const T t2 = phi.squaredNorm();
+  T c1, c2;
+  if (t2 < T(1e-8)) {
+    c1 = T(0.5) - t2 / T(24) + t2 * t2 / T(720);
+    c2 = T(1.0 / 6.0) - t2 / T(120) + t2 * t2 / T(5040);
+  } else {
+    const T t = sqrt(t2);
+    c1 = (T(1) - cos(t)) / t2;
+    c2 = (t - sin(t)) / (t2 * t);
+  }
+  const Matrix3<T> K = Skew(phi);
+  return Matrix3<T>::Identity() - c1 * K + c2 * K * K;
 }
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
+/// Inverse of the right Jacobian: Log(Exp(phi) Exp(d)) = phi + Jr^-1(phi) d + O(|d|^2),
+///   Jr^-1(phi) = I + [phi]x / 2 + (1/t^2 - (1 + cos t) / (2 t sin t)) [phi]x^2,
+/// with the series 1/12 + t^2/720 + t^4/30240 below t^2 = 1e-8 (cancellation). Also the
+/// rate of a rotation vector: d(phi)/dt = Jr^-1(phi) omega_b for R = R0 Exp(phi).
+/// Valid for |phi| < 2 pi (sin t = 0 at t = 2 pi).
+template <typename T>
+Matrix3<T> RightJacobianInverseSO3(const Vector3<T>& phi) {
+  using std::cos;
+  using std::sin;
+  using std::sqrt;
+  const T t2 = phi.squaredNorm();
+  T c;
+  if (t2 < T(1e-8)) {
+    c = T(1.0 / 12.0) + t2 / T(720) + t2 * t2 / T(30240);
+  } else {
+    const T t = sqrt(t2);
+    c = T(1) / t2 - (T(1) + cos(t)) / (T(2) * t * sin(t));
+  }
+  const Matrix3<T> K = Skew(phi);
+  return Matrix3<T>::Identity() + T(0.5) * K + c * K * K;
+}
+
+/// Wraps an angle to (-pi, pi]: a - 2 pi floor((a + pi) / 2 pi), then -pi moved to pi.
+/// Templated: for a ceres::Jet the floor has derivative 0, so d wrap(a) / da = 1.
+template <typename T>
+T WrapPi(const T& a_rad) {
+  using std::floor;
+  const T two_pi(kTwoPi);
+  T r = a_rad - two_pi * floor((a_rad + T(kPi)) / two_pi);
+  if (r <= T(-kPi)) r += two_pi;
+  if (r > T(kPi)) r -= two_pi;
+  return r;
+}
 
 }  // namespace navtwin

@@ -20,24 +20,6 @@ namespace {
 
 using Matrix9d = ImuPreintegration::Matrix9d;
 
-/// SO(3) right Jacobian, Exp(phi + e) = Exp(phi) Exp(J_r(phi) e) to first order in e:
-///   J_r(phi) = I - (1 - cos t)/t^2 [phi]x + (t - sin t)/t^3 [phi]x^2,  t = |phi|,
-/// with the series 1/2 - t^2/24 and 1/6 - t^2/120 below t = 1e-4 (truncation < 1e-18).
-Eigen::Matrix3d RightJacobian(const Eigen::Vector3d& phi) {
-  const double t2 = phi.squaredNorm();
-  double c1, c2;
-  if (t2 < 1e-8) {
-    c1 = 0.5 - t2 / 24.0;
-    c2 = 1.0 / 6.0 - t2 / 120.0;
-  } else {
-    const double t = std::sqrt(t2);
-    c1 = (1.0 - std::cos(t)) / t2;
-    c2 = (t - std::sin(t)) / (t2 * t);
-  }
-  const Eigen::Matrix3d k = Skew<double>(phi);
-  return Eigen::Matrix3d::Identity() - c1 * k + c2 * k * k;
-}
-
 /// What the factor needs from a preintegration (copied when the factor is made).
 struct ImuFactorData {
   double dt_s = 0.0;
@@ -261,7 +243,7 @@ void ImuPreintegration::Propagate(const ImuSample& sample) {
   A.block<3, 3>(6, 0) = -dR * Skew<double>(s) * dt;
   A.block<3, 3>(6, 3) = I3 * dt;
   Eigen::Matrix<double, 9, 3> B_g, B_a;
-  B_g.block<3, 3>(0, 0) = RightJacobian(a);
+  B_g.block<3, 3>(0, 0) = RightJacobianSO3(a);
   B_g.block<3, 3>(3, 0) = -0.5 * dR * Skew<double>(u);
   B_g.block<3, 3>(6, 0) = -dR * Skew<double>(u) * (dt / 6.0);
   B_a.block<3, 3>(0, 0).setZero();

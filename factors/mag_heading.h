@@ -58,14 +58,6 @@ inline void CheckSigma(double sigma_rad, const char* what) {
     throw std::invalid_argument(std::string(what) + ": sigma_rad must be positive and finite");
   }
 }
-/// wrap(a) = atan2(sin a, cos a) in (-pi, pi].
-template <typename T>
-T WrapAngle(const T& a) {
-  using std::atan2;
-  using std::cos;
-  using std::sin;
-  return atan2(sin(a), cos(a));
-}
 }  // namespace mag_heading_detail
 
 class MagHeading {
@@ -100,7 +92,7 @@ class MagHeading {
       residual[0] = T(0.0);
       return true;
     }
-    const T a = mag_heading_detail::WrapAngle(atan2(m_n.y(), m_n.x()) - T(declination_rad_));
+    const T a = WrapPi(atan2(m_n.y(), m_n.x()) - T(declination_rad_));
     residual[0] = sqrt(h2) * a * T(inv_sigma_h0_);
     return true;
   }
@@ -164,7 +156,7 @@ class MagHeading2Axis {
     const Eigen::Map<const Quaternion<T>> q_n_b(q_n_b_ptr);
     const Matrix3<T> R_n_b = DcmFromQuat<T>(q_n_b);
     const T yaw = atan2(R_n_b(1, 0), R_n_b(0, 0));
-    residual[0] = mag_heading_detail::WrapAngle(yaw - T(heading_meas_rad_)) * T(inv_sigma_);
+    residual[0] = WrapPi(yaw - T(heading_meas_rad_)) * T(inv_sigma_);
     return true;
   }
 

@@ -25,19 +25,9 @@
 #include <ceres/manifold.h>
 
 #include "core/earth.h"
+#include "core/rotation.h"
 
 namespace navtwin {
-
-namespace position_manifold_detail {
-/// Wraps an angle within 2 pi of (-pi, pi] into it. A branch on the value, so a Jet keeps
-/// its derivative (d wrap = 1).
-template <typename T>
-T WrapLongitude(T a) {
-  if (a > T(M_PI)) a -= T(2.0 * M_PI);
-  if (a <= T(-M_PI)) a += T(2.0 * M_PI);
-  return a;
-}
-}  // namespace position_manifold_detail
 
 /// out = Plus(x, delta): x = {lat_rad, lon_rad, h_m}, delta = dp_ned_m. Templated for Jets.
 /// out must not alias x or delta.
@@ -47,7 +37,7 @@ void PositionPlus(const T* x, const T* delta, T* out) {
   const T rm_h = wgs84::MeridianRadius(x[0]) + x[2];
   const T rn_h = wgs84::PrimeVerticalRadius(x[0]) + x[2];
   out[0] = x[0] + delta[0] / rm_h;
-  out[1] = position_manifold_detail::WrapLongitude(x[1] + delta[1] / (rn_h * cos(x[0])));
+  out[1] = WrapPi(x[1] + delta[1] / (rn_h * cos(x[0])));
   out[2] = x[2] - delta[2];
 }
 
@@ -58,7 +48,7 @@ void PositionMinus(const T* y, const T* x, T* out) {
   using std::cos;
   const T rm_h = wgs84::MeridianRadius(x[0]) + x[2];
   const T rn_h = wgs84::PrimeVerticalRadius(x[0]) + x[2];
-  const T dlon = position_manifold_detail::WrapLongitude(T(y[1] - x[1]));
+  const T dlon = WrapPi(T(y[1] - x[1]));
   out[0] = (y[0] - x[0]) * rm_h;
   out[1] = dlon * rn_h * cos(x[0]);
   out[2] = -(y[2] - x[2]);

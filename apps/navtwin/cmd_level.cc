@@ -24,8 +24,6 @@ DEFINE_bool(allow_motion, false, "level: level even when the window shows motion
 namespace navtwin::app {
 namespace {
 
-constexpr double kMilliG_mps2 = 1e-3 * leveling::kStandardGravity_mps2;
-
 int Usage(const std::string& why) {
   const std::string usage = LevelCommand().usage;
   std::cerr << "navtwin level: " << why << "\nusage: " << usage.substr(0, usage.find('\n'))

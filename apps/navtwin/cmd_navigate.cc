@@ -23,6 +23,7 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/io/json_writer.h"
+#include "core/units.h"
 #include "problems/gnss_ins/run.h"
 
 DEFINE_string(kfgins_config, "", "KF-GINS YAML configuration, taken unchanged (its imupath, gnsspath, outputpath are used when --imu, --gnss, --out are not given)");
@@ -111,7 +112,7 @@ std::string ApplyVehicleFlags(GnssInsConfig* config) {
     if (!ParseTriple(FLAGS_vehicle_mounting_rpy_deg, &rpy_deg)) {
       return "--vehicle_mounting_rpy_deg must be three numbers roll,pitch,yaw";
     }
-    config->vehicle.mounting_rpy_rad = rpy_deg * (M_PI / 180.0);
+    config->vehicle.mounting_rpy_rad = rpy_deg * kDegToRad;
   }
   if (!FLAGS_vehicle_lever_arm_b_m.empty() &&
       !ParseTriple(FLAGS_vehicle_lever_arm_b_m, &config->vehicle.lever_arm_b_m)) {

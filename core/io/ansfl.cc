@@ -12,11 +12,11 @@
 #include "core/io/rate_to_increment.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
 
-constexpr double kMicro = 1e-6;
 constexpr std::uint64_t kDotClockModulus = 1ULL << 32;  // SampleTimeFine is a uint32 (us)
 /// A repeated time tag is the lost-sample pattern only after an interval this many times
 /// longer than the one before it (the pattern leaves a double interval: ratio 2).
@@ -194,7 +194,7 @@ class DotRows {
     if (has_last_tick_ && ticks < last_tick_ && last_tick_ - ticks > kDotClockModulus / 2) ++wraps_;
     last_tick_ = ticks;
     has_last_tick_ = true;
-    return static_cast<double>(ticks + wraps_ * kDotClockModulus) * kMicro;
+    return static_cast<double>(ticks + wraps_ * kDotClockModulus) * kMicrosecond_s;
   }
 
   CsvRows csv_;
@@ -234,7 +234,7 @@ class DotImuReader final : public ImuReader {
       ++used_;
       RateSample rate;
       rate.t_s = r.t_s;
-      rate.gyro_rad_s = r.gyro_dps * kDegToRad;
+      rate.gyro_radps = r.gyro_dps * kDegToRad;
       rate.acc_mps2 = r.acc_mps2;
       if (to_increment_.Add(rate, sample)) return true;
     }
@@ -320,7 +320,7 @@ class GtExtRows {
   bool Next(GtExtRow* r) {
     if (!csv_.Next()) return false;
     r->line = csv_.line();
-    r->t_s = csv_.Get(time_) * 1e-3;
+    r->t_s = csv_.Get(time_) * kMillisecond_s;
     time_check_.Check(r->t_s, path(), r->line, "time");
     const double lat_deg = csv_.Get(lat_);
     if (std::fabs(lat_deg) > 90.0) {

@@ -22,7 +22,7 @@ class CsvImuReader final : public ImuReader {
       if (rates_) {
         RateSample r;
         r.t_s = time_s_;
-        r.gyro_rad_s = Triple(0);
+        r.gyro_radps = Triple(0);
         r.acc_mps2 = Triple(3);
         if (to_increment_.Add(r, sample)) return true;
       } else {

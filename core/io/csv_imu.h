@@ -17,11 +17,10 @@
 
 #include "core/io/atomic_file.h"
 #include "core/io/sample_reader.h"
+#include "core/units.h"
 
 namespace navtwin {
 
-/// Standard gravity (the "g" of acc_*_g columns), m/s^2.
-constexpr double kStandardGravity_mps2 = 9.80665;
 
 std::unique_ptr<ImuReader> OpenCsvImu(const std::string& path);
 

@@ -9,12 +9,12 @@
 
 #include "core/io/input_error.h"
 #include "core/io/text_reader.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kAbsoluteZero_degC = -273.15;
 
 /// The rows of a headed CSV file: header found, field count and time checked per row.
 class CsvTable {
@@ -81,11 +81,10 @@ class CsvTable {
 class CsvMagReader final : public MagReader {
  public:
   explicit CsvMagReader(const std::string& path) : table_(path) {
-    constexpr double kGauss_uT = 100.0, kNano_uT = 1e-3;
     const char* axes[3] = {"mx", "my", "mz"};
     for (int k = 0; k < 3; ++k) {
       axes_[k] = table_.header().RequireWithUnit(
-          axes[k], {{"_uT", 1.0}, {"_G", kGauss_uT}, {"_ga", kGauss_uT}, {"_nT", kNano_uT}});
+          axes[k], {{"_uT", 1.0}, {"_G", kGauss_uT}, {"_ga", kGauss_uT}, {"_nT", kNanotesla_uT}});
     }
   }
 

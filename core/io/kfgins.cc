@@ -10,11 +10,11 @@
 #include "core/io/text_line.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
 
-constexpr double kSecondsPerWeek = 604800.0;
 
 /// Numeric rows of a KF-GINS file: blank and '#' lines skipped, fields split, the column
 /// count checked against the first row (which must be one of the allowed counts).

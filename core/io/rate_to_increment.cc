@@ -16,7 +16,7 @@ bool RateToIncrement::Add(const RateSample& sample, ImuSample* out) {
   }
   out->t_s = sample.t_s;
   out->dt_s = dt_s;
-  out->dtheta_b_rad = 0.5 * (previous_.gyro_rad_s + sample.gyro_rad_s) * dt_s;
+  out->dtheta_b_rad = 0.5 * (previous_.gyro_radps + sample.gyro_radps) * dt_s;
   out->dv_b_mps = 0.5 * (previous_.acc_mps2 + sample.acc_mps2) * dt_s;
   previous_ = sample;
   return true;

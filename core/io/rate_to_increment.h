@@ -20,7 +20,7 @@ namespace navtwin {
 /// One rate sample in the sensor axes.
 struct RateSample {
   double t_s = 0.0;
-  Eigen::Vector3d gyro_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d acc_mps2 = Eigen::Vector3d::Zero();  ///< specific force
 };
 

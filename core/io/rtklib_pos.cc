@@ -12,8 +12,9 @@
 namespace navtwin {
 namespace {
 
-constexpr std::int64_t kSecondsPerDay = 86400;
-constexpr std::int64_t kSecondsPerWeek = 604800;
+// Whole seconds (integer arithmetic on GPS time).
+constexpr std::int64_t kDayWhole_s = static_cast<std::int64_t>(kSecondsPerDay);
+constexpr std::int64_t kWeekWhole_s = static_cast<std::int64_t>(kSecondsPerWeek);
 
 std::int64_t FloorDiv(std::int64_t a, std::int64_t b) {
   std::int64_t q = a / b;
@@ -235,7 +236,7 @@ class RtklibPosReader final : public GnssReader {
     if (EqualsNoCase(header_.time_system, "UTC")) sow += header_.leap_s;
     if (first_week_ < 0) first_week_ = week;
     s->gps_week = static_cast<int>(first_week_);
-    s->t_s = static_cast<double>((week - first_week_) * kSecondsPerWeek) + sow;
+    s->t_s = static_cast<double>((week - first_week_) * kWeekWhole_s) + sow;
     time_.Check(s->t_s, path(), line, "time");
   }
 
@@ -269,7 +270,7 @@ class RtklibPosReader final : public GnssReader {
         DaysFromCivil(static_cast<int>(y), static_cast<int>(mo), static_cast<int>(d)) -
         DaysFromCivil(1980, 1, 6);
     *week = FloorDiv(days, 7);
-    *sow = static_cast<double>((days - *week * 7) * kSecondsPerDay + hh * 3600 + mm * 60) + ss;
+    *sow = static_cast<double>((days - *week * 7) * kDayWhole_s + hh * 3600 + mm * 60) + ss;
   }
 
   LineReader lines_;
@@ -295,11 +296,11 @@ std::int64_t DaysFromCivil(int year, int month, int day) {
 }
 
 GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s) {
-  const std::int64_t since_gps_epoch = seconds - DaysFromCivil(1980, 1, 6) * kSecondsPerDay;
+  const std::int64_t since_gps_epoch = seconds - DaysFromCivil(1980, 1, 6) * kDayWhole_s;
   GpsWeekTime t;
-  const std::int64_t week = FloorDiv(since_gps_epoch, kSecondsPerWeek);
+  const std::int64_t week = FloorDiv(since_gps_epoch, kWeekWhole_s);
   t.week = static_cast<int>(week);
-  t.sow_s = static_cast<double>(since_gps_epoch - week * kSecondsPerWeek) + fraction_s;
+  t.sow_s = static_cast<double>(since_gps_epoch - week * kWeekWhole_s) + fraction_s;
   return t;
 }
 

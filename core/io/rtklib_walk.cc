@@ -17,6 +17,7 @@
 #include "core/io/rtklib_pos.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
@@ -25,7 +26,6 @@ constexpr std::size_t kTagHeaderBytes = 60;    // text, starting "TIMETAG RTKLIB
 constexpr std::size_t kTagPreambleBytes = 76;  // header + tick_f + time + fraction
 constexpr std::size_t kTagRecordBytes = 8;     // uint32 tick_ms, uint32 file position
 constexpr std::size_t kRawFields = 7;          // ax ay az gx gy gz t
-constexpr double kSecondsPerWeek = 604800.0;
 /// Host tick steps above this are pauses in the data, not the tick period.
 constexpr std::uint32_t kMaxTickStepMs = 1000;
 /// Tick repeats in at least 1 of this many records mean the tick is coarser than writes.
@@ -208,7 +208,7 @@ class RawRows {
     const long long t = ParseInteger(fields_[6], path(), line(), "t");
     if (t < 0) throw InputError(path(), line(), "t", "negative device time");
     row->device_ms = static_cast<double>(t);
-    time_.Check(row->device_ms * 1e-3, path(), line(), "t");
+    time_.Check(row->device_ms * kMillisecond_s, path(), line(), "t");
     row->end_offset = lines_.end_offset();
     row->lf_breaks = lf_breaks_;
     ++rows_;
@@ -304,7 +304,7 @@ class WalkImuReader final : public ImuReader {
       rate.t_s = clock_.GpsSow(r.device_ms);
       for (int k = 0; k < 3; ++k) {
         rate.acc_mps2[k] = r.acc_g[k] * kStandardGravity_mps2;
-        rate.gyro_rad_s[k] = r.gyro_dps[k] * kDegToRad;
+        rate.gyro_radps[k] = r.gyro_dps[k] * kDegToRad;
       }
       if (to_increment_.Add(rate, sample)) return true;
     }
@@ -361,7 +361,7 @@ class WalkSfReader final : public ImuReader {
     for (int k = 0; k < 3; ++k) {
       r.acc_mps2[k] =
           ParseDouble(fields_[1 + k], path(), line(), kNames[k]) * kStandardGravity_mps2;
-      r.gyro_rad_s[k] = ParseDouble(fields_[4 + k], path(), line(), kNames[3 + k]);
+      r.gyro_radps[k] = ParseDouble(fields_[4 + k], path(), line(), kNames[3 + k]);
     }
     return r;
   }
@@ -404,7 +404,7 @@ std::string Fixed(double v, int decimals) {
 
 double RtklibWalkClock::GpsSow(double device_ms) const {
   const double x = device_ms - first_device_ms;
-  return open_sow_s + (x * (1.0 + drift) + offset_ms + tick_period_ms) * 1e-3;
+  return open_sow_s + (x * (1.0 + drift) + offset_ms + tick_period_ms) * kMillisecond_s;
 }
 
 RtklibWalkClock FitRtklibWalkClock(const std::string& path) {
@@ -434,7 +434,7 @@ RtklibWalkClock FitRtklibWalkClock(const std::string& path) {
   envelope.Fit(&clock.offset_ms, &clock.drift, &clock.mean_delay_ms);
   if (std::fabs(clock.drift) > kMaxDrift) {
     throw InputError(tags.path(), 0, "",
-                     "device and host clocks would differ by " + Fixed(clock.drift * 1e6, 0) +
+                     "device and host clocks would differ by " + Fixed(clock.drift / kPpm, 0) +
                          " ppm: the tags do not fit " + path);
   }
   clock.tick_period_ms = tags.TickPeriodMs();
@@ -463,7 +463,7 @@ FileSummary DescribeRtklibWalkImu(const std::string& path) {
   summary.notes.push_back(
       "device ms -> GPS: file opened at " + Fixed(c.open_sow_s, 3) + " s of week; first line " +
       Fixed(c.first_device_ms, 0) + " ms at +" + Fixed(c.offset_ms + c.tick_period_ms, 1) +
-      " ms; drift " + Fixed(c.drift * 1e6, 1) + " ppm; host tick " + Fixed(c.tick_period_ms, 2) +
+      " ms; drift " + Fixed(c.drift / kPpm, 1) + " ppm; host tick " + Fixed(c.tick_period_ms, 2) +
       " ms; mean receipt delay above the envelope " + Fixed(c.mean_delay_ms, 1) + " ms; " +
       std::to_string(c.paired_lines) + " lines paired with tags" +
       (c.crlf_positions ? "; tag positions count CRLF line ends" : ""));

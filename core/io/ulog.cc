@@ -10,14 +10,13 @@
 #include "core/io/input_error.h"
 #include "core/io/ulog_format.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
 
 using ulog::BaseType;
 
-constexpr double kUsToS = 1e-6;
-constexpr double kGaussToMicrotesla = 100.0;
 constexpr double kMinFixType = 3;  // PX4 fix_type: 0-1 none, 2 2D, 3 3D, 4+ DGPS/RTK
 // PX4's marker for "no sample" in *_timestamp_relative fields (INT32_MAX).
 constexpr double kRelativeTimestampInvalid = 2147483647.0;
@@ -488,9 +487,9 @@ class TimeOrderedTopic {
 
   const ULogFile& log() const { return log_; }
   const std::string& topic() const { return topic_; }
-  double t_s() const { return static_cast<double>(time_us_) * kUsToS; }
+  double t_s() const { return static_cast<double>(time_us_) * kMicrosecond_s; }
   bool has_previous() const { return has_previous_; }
-  double dt_s() const { return static_cast<double>(time_us_ - previous_us_) * kUsToS; }
+  double dt_s() const { return static_cast<double>(time_us_ - previous_us_) * kMicrosecond_s; }
 
   /// A finite field value; InputError naming the field otherwise.
   double Finite(const std::string& field, int index = -1) const {
@@ -566,7 +565,7 @@ class ULogImuReader final : public ImuReader {
                                "negative integration time");
     }
     const std::string type = topic_.log().FieldType(field);
-    return type == "float" || type == "double" ? v : v * kUsToS;
+    return type == "float" || type == "double" ? v : v * kMicrosecond_s;
   }
 
   std::string path_;
@@ -665,7 +664,7 @@ class ULogMagReader final : public MagReader {
         xyz ? Eigen::Vector3d(topic_.Finite("x"), topic_.Finite("y"), topic_.Finite("z"))
             : topic_.Vector("magnetometer_ga");
     s->t_s = topic_.t_s();
-    s->m_b_uT = kGaussToMicrotesla * gauss;
+    s->m_b_uT = kGauss_uT * gauss;
     return true;
   }
   const std::string& path() const override { return path_; }
@@ -760,7 +759,7 @@ FileSummary DescribeULog(const std::string& path) {
     const std::uint64_t t_us = log.timestamp_us();
     if (st.stats.count() > 0 && t_us == st.last_us) ++st.repeated;
     if (st.stats.count() > 0 && t_us < st.last_us) ++st.backwards;
-    st.stats.Add(static_cast<double>(t_us) * kUsToS);
+    st.stats.Add(static_cast<double>(t_us) * kMicrosecond_s);
     st.last_us = t_us;
   }
   FileSummary summary;

@@ -8,6 +8,7 @@
 
 #include "core/earth.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 namespace {
@@ -20,8 +21,6 @@ constexpr double kSameTime_s = 1e-9;
 constexpr double kMinReportedSigma = 1e-3;
 /// IGRF-13 axial dipole term |g10| at epoch 2020.0 (29404.8 nT), uT.
 constexpr double kDipoleField_uT = 29.4048;
-constexpr double kMrad = 1e-3;
-constexpr double kSqrtHour_s = 60.0;  // sqrt(3600 s)
 
 // ------------------------------------------------------------------ interpolation
 
@@ -52,17 +51,7 @@ Eigen::Vector3d BodyRateOverNed(const TruthSample& x) {
   const NavState& s = x.state;
   const Eigen::Vector3d w_in =
       wgs84::EarthRateNed(s.lat_rad) + wgs84::TransportRateNed(s.lat_rad, s.h_m, s.v_n_mps);
-  return x.omega_ib_b_rad_s - s.q_n_b.conjugate() * w_in;
-}
-
-/// Inverse right Jacobian of SO(3): d(phi)/dt = Jr^-1(phi) omega for R = R0 Exp(phi).
-Eigen::Matrix3d InverseRightJacobian(const Eigen::Vector3d& phi) {
-  const double t = phi.norm();
-  // 1/t^2 - (1 + cos t) / (2 t sin t), with its series below 1e-4 rad (cancellation).
-  const double c = t < 1e-4 ? 1.0 / 12.0 + t * t / 720.0
-                            : 1.0 / (t * t) - (1.0 + std::cos(t)) / (2.0 * t * std::sin(t));
-  const Eigen::Matrix3d K = Skew(phi);
-  return Eigen::Matrix3d::Identity() + 0.5 * K + c * K * K;
+  return x.omega_ib_b_radps - s.q_n_b.conjugate() * w_in;
 }
 
 Eigen::Vector3d Lerp(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double s) {
@@ -196,11 +185,11 @@ TruthSample InterpolateTruth(const TruthSample& a, const TruthSample& b, double 
   // phi_1 = Log(q_a^-1 q_b) (slope Jr^-1(phi_1) omega_nb_b(b)).
   const Eigen::Vector3d phi1 = RotVecFromQuat(Eigen::Quaterniond(sa.q_n_b.conjugate() * sb.q_n_b));
   const Eigen::Vector3d phi = w.Blend(Eigen::Vector3d::Zero(), BodyRateOverNed(a), phi1,
-                                      InverseRightJacobian(phi1) * BodyRateOverNed(b));
+                                      RightJacobianInverseSO3(phi1) * BodyRateOverNed(b));
   out.state.q_n_b = (sa.q_n_b * QuatFromRotVec(phi)).normalized();
 
-  out.omega_ib_b_rad_s =
-      w.Blend(a.omega_ib_b_rad_s, a.alpha_ib_b_rad_s2, b.omega_ib_b_rad_s, b.alpha_ib_b_rad_s2);
+  out.omega_ib_b_radps =
+      w.Blend(a.omega_ib_b_radps, a.alpha_ib_b_rad_s2, b.omega_ib_b_radps, b.alpha_ib_b_rad_s2);
   out.f_b_mps2 = Lerp(a.f_b_mps2, b.f_b_mps2, s);
   out.alpha_ib_b_rad_s2 = Lerp(a.alpha_ib_b_rad_s2, b.alpha_ib_b_rad_s2, s);
   out.a_n_mps2 = Lerp(a.a_n_mps2, b.a_n_mps2, s);
@@ -266,8 +255,7 @@ GnssSimConfig ParseGnssSimConfig(const ConfigNode& node) {
   c.position_sigma_ned_m = SigmaNed(node, "position_sigma_m");
   c.velocity_sigma_ned_mps = SigmaNed(node, "velocity_sigma_mps");
   c.lever_arm_b_m = node.Vector("lever_arm_b_m", c.lever_arm_b_m);
-  constexpr double kDay_s = 86400.0;
-  c.time_offset_s = node.Double("time_offset_s", 0.0, -kDay_s, kDay_s);
+  c.time_offset_s = node.Double("time_offset_s", 0.0, -kSecondsPerDay, kSecondsPerDay);
   for (const ConfigNode& e : node.Elements("outages")) c.outages_s.push_back(Interval(e));
   c.outlier_probability = node.Double("outlier_probability", 0.0, 0.0, 1.0);
   c.outlier_size_m = node.Double("outlier_size_m", 0.0, 0.0, kInf);
@@ -301,7 +289,7 @@ GnssSample AntennaTruth(const TruthSample& truth, const Eigen::Vector3d& lever_a
   g.h_m = antenna.h_m;
   // Earth-relative velocity of the antenna in the IMU's NED, then in the antenna's NED.
   const Eigen::Vector3d v_imu_ned = s.v_n_mps +
-                                    R_n_b * truth.omega_ib_b_rad_s.cross(lever_arm_b_m) -
+                                    R_n_b * truth.omega_ib_b_radps.cross(lever_arm_b_m) -
                                     wgs84::EarthRateNed(s.lat_rad).cross(arm_n);
   g.v_n_mps = wgs84::RotationEcefFromNed(antenna.lat_rad, antenna.lon_rad).transpose() *
               wgs84::RotationEcefFromNed(s.lat_rad, s.lon_rad) * v_imu_ned;
@@ -462,8 +450,8 @@ MagSimulator::MagSimulator(const MagSimConfig& config, double start_lat_rad, con
       sampler_(config.rate_hz, 0.0, 0.0),
       noise_rng_(rng.Stream("mag.noise")) {
   if (!perfect) {
-    hard_iron_uT_ = DrawHardIron(config, rng.Stream("mag.hard_iron"));
-    soft_iron_ = DrawSoftIron(config, rng.Stream("mag.soft_iron"));
+    iron_.hard_iron_uT = DrawHardIron(config, rng.Stream("mag.hard_iron"));
+    iron_.soft_iron = DrawSoftIron(config, rng.Stream("mag.soft_iron"));
   }
 }
 
@@ -473,7 +461,7 @@ std::optional<MagSample> MagSimulator::Push(const TruthSample& truth) {
   MagSample m;
   m.t_s = epoch->tag_s;
   const Eigen::Vector3d field_b = epoch->truth.state.q_n_b.conjugate() * field_ned_uT_;
-  m.m_b_uT = (Eigen::Matrix3d::Identity() + soft_iron_) * field_b + hard_iron_uT_;
+  m.m_b_uT = iron_.Apply(field_b);
   if (!perfect_) m.m_b_uT += noise_rng_.Normal3(config_.noise_uT);
   if (config_.two_axis) m.m_b_uT.z() = 0.0;
   return m;
@@ -487,8 +475,8 @@ void MagSimulator::EmitDrawn(YAML::Emitter& out) const {
   EmitValue(out, "inclination_deg", inclination_rad_ * kRadToDeg);
   EmitValue(out, "intensity_uT", intensity_uT_);
   EmitVector(out, "field_ned_uT", field_ned_uT_, 1.0);
-  EmitVector(out, "hard_iron_uT", hard_iron_uT_, 1.0);
-  EmitMatrix(out, "soft_iron", soft_iron_);
+  EmitVector(out, "hard_iron_uT", iron_.hard_iron_uT, 1.0);
+  EmitMatrix(out, "soft_iron", iron_.soft_iron);
   EmitValue(out, "noise_uT", perfect_ ? 0.0 : config_.noise_uT);
   out << YAML::Key << "two_axis" << YAML::Value << config_.two_axis;
   out << YAML::EndMap;
@@ -518,7 +506,6 @@ constexpr double kIsaTropopause_m = 11000.0;
 constexpr double kIsaT11_K = 216.65;
 constexpr double kIsaTop_m = 20000.0;  // end of the isothermal layer
 constexpr double kIsaBottom_m = -5000.0;
-constexpr double kIsaG0_mps2 = 9.80665;
 constexpr double kIsaMolarMass_kg_mol = 0.0289644;
 constexpr double kIsaGasConstant = 8.31432;      // J/(mol K), the 1976 value
 constexpr double kIsaEarthRadius_m = 6356766.0;  // r0 of the geopotential altitude
@@ -541,12 +528,12 @@ double IsaTemperature_K(double altitude_m) {
 
 double IsaPressure_pa(double altitude_m) {
   const double H = Geopotential_m(altitude_m);
-  const double exponent = kIsaG0_mps2 * kIsaMolarMass_kg_mol / (kIsaGasConstant * kIsaLapse_K_m);
+  const double exponent = kStandardGravity_mps2 * kIsaMolarMass_kg_mol / (kIsaGasConstant * kIsaLapse_K_m);
   if (H < kIsaTropopause_m) {
     return kIsaP0_pa * std::pow((kIsaT0_K - kIsaLapse_K_m * H) / kIsaT0_K, exponent);
   }
   const double p11 = kIsaP0_pa * std::pow(kIsaT11_K / kIsaT0_K, exponent);
-  return p11 * std::exp(-kIsaG0_mps2 * kIsaMolarMass_kg_mol * (H - kIsaTropopause_m) /
+  return p11 * std::exp(-kStandardGravity_mps2 * kIsaMolarMass_kg_mol * (H - kIsaTropopause_m) /
                         (kIsaGasConstant * kIsaT11_K));
 }
 
@@ -617,7 +604,7 @@ std::optional<OdometerSample> OdometerSimulator::Push(const TruthSample& truth) 
   if (!epoch) return std::nullopt;
   const TruthSample& x = epoch->truth;
   const Eigen::Vector3d v_b =
-      x.state.q_n_b.conjugate() * x.state.v_n_mps + x.omega_ib_b_rad_s.cross(config_.lever_arm_b_m);
+      x.state.q_n_b.conjugate() * x.state.v_n_mps + x.omega_ib_b_radps.cross(config_.lever_arm_b_m);
   OdometerSample s;
   s.t_s = epoch->tag_s;
   s.speed_mps = (1.0 + scale_factor_) * v_b.x();
@@ -644,13 +631,13 @@ MasterSimConfig ParseMasterSimConfig(const ConfigNode& node) {
   c.rate_hz = Rate(node, c.rate_hz, 1000.0);
   c.transfer_delay_s = node.Double("transfer_delay_s", 0.0, 0.0, 10.0);
   RequireNotBoth(node, "attitude_error_sigma_mrad", "attitude_error_fixed_mrad");
-  c.attitude_error_sigma_rad = node.Double("attitude_error_sigma_mrad", 0.0, 0.0, kInf) * kMrad;
+  c.attitude_error_sigma_rad = node.Double("attitude_error_sigma_mrad", 0.0, 0.0, kInf) * kMrad_rad;
   if (node.Has("attitude_error_fixed_mrad")) {
     c.attitude_error_fixed_rad =
-        node.Vector("attitude_error_fixed_mrad", Eigen::Vector3d::Zero()) * kMrad;
+        node.Vector("attitude_error_fixed_mrad", Eigen::Vector3d::Zero()) * kMrad_rad;
   }
   c.attitude_random_walk_rad_sqrt_s =
-      node.Double("attitude_random_walk_mrad_sqrt_h", 0.0, 0.0, kInf) * kMrad / kSqrtHour_s;
+      node.Double("attitude_random_walk_mrad_sqrt_h", 0.0, 0.0, kInf) * kMrad_rad / kSqrtHour_sqrts;
   c.velocity_noise_mps = node.Double("velocity_noise_mps", 0.0, 0.0, kInf);
   return c;
 }
@@ -689,10 +676,10 @@ void MasterSimulator::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::Key << "perfect" << YAML::Value << perfect_;
   EmitValue(out, "rate_hz", config_.rate_hz);
   EmitValue(out, "transfer_delay_s", config_.transfer_delay_s);
-  EmitVector(out, "attitude_error_mrad", constant_error_rad_, kMrad);
+  EmitVector(out, "attitude_error_mrad", constant_error_rad_, kMrad_rad);
   EmitValue(out, "attitude_random_walk_mrad_sqrt_h",
-            perfect_ ? 0.0 : config_.attitude_random_walk_rad_sqrt_s * kSqrtHour_s / kMrad);
-  EmitVector(out, "attitude_random_walk_now_mrad", random_walk_rad_, kMrad);
+            perfect_ ? 0.0 : config_.attitude_random_walk_rad_sqrt_s * kSqrtHour_sqrts / kMrad_rad);
+  EmitVector(out, "attitude_random_walk_now_mrad", random_walk_rad_, kMrad_rad);
   EmitValue(out, "velocity_noise_mps", perfect_ ? 0.0 : config_.velocity_noise_mps);
   out << YAML::EndMap;
 }

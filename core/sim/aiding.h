@@ -23,9 +23,10 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
+#include "core/config/yaml_config.h"
+#include "core/mag_iron_model.h"
 #include "core/sim/random.h"
 #include "core/sim/truth.h"
-#include "core/sim/yaml_config.h"
 #include "core/io/csv_odometer.h"
 #include "core/types.h"
 
@@ -158,8 +159,8 @@ MagSimConfig ParseMagSimConfig(const ConfigNode& node);
 Eigen::Vector3d MagneticFieldNed_uT(double declination_rad, double inclination_rad,
                                     double intensity_uT);
 
-/// Magnetometer: m_b = (I + S) R_b_n m_n + h + n (uT), S soft iron, h hard iron, n white
-/// noise. A 2-axis sensor (seed 001's HMC1052) has no z axis: m_z = 0 (noise and iron
+/// Magnetometer: m_b = (I + S) R_b_n m_n + h + n (uT), S soft iron, h hard iron
+/// (core/mag_iron_model.h), n white noise. A 2-axis sensor (seed 001's HMC1052) has no z axis: m_z = 0 (noise and iron
 /// included), so its readers must ignore z. Missing field values default to a centred
 /// axial dipole at the start latitude lat (geographic = magnetic latitude):
 /// D = 0, tan I = 2 tan(lat), B = B0 sqrt(1 + 3 sin^2 lat), B0 = 29.4 uT (the IGRF-13
@@ -172,16 +173,16 @@ class MagSimulator {
   void EmitDrawn(YAML::Emitter& out) const;
 
   const Eigen::Vector3d& field_ned_uT() const { return field_ned_uT_; }
-  const Eigen::Vector3d& hard_iron_uT() const { return hard_iron_uT_; }
-  const Eigen::Matrix3d& soft_iron() const { return soft_iron_; }  ///< S of (I + S)
+  const MagIronModel& iron() const { return iron_; }
+  const Eigen::Vector3d& hard_iron_uT() const { return iron_.hard_iron_uT; }
+  const Eigen::Matrix3d& soft_iron() const { return iron_.soft_iron; }  ///< S of (I + S)
 
  private:
   MagSimConfig config_;
   bool perfect_;
   double declination_rad_, inclination_rad_, intensity_uT_;
   Eigen::Vector3d field_ned_uT_;
-  Eigen::Vector3d hard_iron_uT_ = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d soft_iron_ = Eigen::Matrix3d::Zero();
+  MagIronModel iron_;  ///< zero when perfect
   EpochSampler sampler_;
   Rng noise_rng_;
 };

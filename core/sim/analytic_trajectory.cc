@@ -5,11 +5,12 @@
 
 #include "core/rotation.h"
 #include "core/sim/truth.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 BodyKinematics BodyKinematicsAt(const TrajectoryPoint& p, double lat_rad, double h_m) {
   const Eigen::Vector3d& e = p.euler_rad;
-  const Eigen::Vector3d& de = p.euler_rate_rad_s;
+  const Eigen::Vector3d& de = p.euler_rate_radps;
   const double sr = std::sin(e.x()), cr = std::cos(e.x());
   const double sp = std::sin(e.y()), cp = std::cos(e.y());
   const Eigen::Vector3d omega_nb_b(de.x() - de.z() * sp, de.y() * cr + de.z() * sr * cp,
@@ -22,7 +23,7 @@ BodyKinematics BodyKinematicsAt(const TrajectoryPoint& p, double lat_rad, double
   const Eigen::Vector3d w_ie = wgs84::EarthRateNed(lat_rad);
   const Eigen::Vector3d w_en = wgs84::TransportRateNed(lat_rad, h_m, p.v_n_mps);
   BodyKinematics k;
-  k.omega_ib_b_rad_s = omega_nb_b + R_b_n * (w_ie + w_en);
+  k.omega_ib_b_radps = omega_nb_b + R_b_n * (w_ie + w_en);
   k.f_b_mps2 = R_b_n * (p.a_n_mps2 + (2.0 * w_ie + w_en).cross(p.v_n_mps) -
                         wgs84::GravityNed(lat_rad, h_m));
   return k;
@@ -48,7 +49,6 @@ void SynthesizeImu(const AnalyticTrajectory& tr, const wgs84::Geodetic& start, d
 }
 
 namespace {
-constexpr double kTwoPi = 2.0 * M_PI;
 // Demo-flight shape: amplitude (rad or m/s) and period (s) of each sinusoid.
 constexpr double kRollAmp = 0.2, kRollPeriod = 60.0;
 constexpr double kPitchMean = 0.02, kPitchAmp = 0.05, kPitchPeriod = 120.0;
@@ -63,7 +63,7 @@ Eigen::Vector3d DemoFlight::Euler_rad(double t) const {
           kYawMean + kYawAmp * std::sin(kTwoPi * t / kYawPeriod)};
 }
 
-Eigen::Vector3d DemoFlight::EulerRate_rad_s(double t) const {
+Eigen::Vector3d DemoFlight::EulerRate_radps(double t) const {
   return {kRollAmp * kTwoPi / kRollPeriod * std::cos(kTwoPi * t / kRollPeriod),
           kPitchAmp * kTwoPi / kPitchPeriod * std::cos(kTwoPi * t / kPitchPeriod),
           kYawAmp * kTwoPi / kYawPeriod * std::cos(kTwoPi * t / kYawPeriod)};
@@ -80,7 +80,7 @@ Eigen::Vector3d DemoFlight::Acceleration_n_mps2(double t) const {
   const double speed = kSpeedMean - kSpeedAmp * std::cos(kTwoPi * t / kSpeedPeriod);
   const double dspeed = kSpeedAmp * kTwoPi / kSpeedPeriod * std::sin(kTwoPi * t / kSpeedPeriod);
   const double yaw = Euler_rad(t).z();
-  const double dyaw = EulerRate_rad_s(t).z();
+  const double dyaw = EulerRate_radps(t).z();
   return {dspeed * std::cos(yaw) - speed * dyaw * std::sin(yaw),
           dspeed * std::sin(yaw) + speed * dyaw * std::cos(yaw),
           -kClimbAmp * kTwoPi / kClimbPeriod * std::cos(kTwoPi * t / kClimbPeriod)};

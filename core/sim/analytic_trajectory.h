@@ -23,7 +23,7 @@ namespace navtwin::sim {
 /// Everything a trajectory says about one instant.
 struct TrajectoryPoint {
   Eigen::Vector3d euler_rad;         ///< (roll, pitch, yaw) of R_n_b
-  Eigen::Vector3d euler_rate_rad_s;  ///< their time derivatives
+  Eigen::Vector3d euler_rate_radps;  ///< their time derivatives
   Eigen::Vector3d v_n_mps;           ///< velocity over the Earth, NED
   Eigen::Vector3d a_n_mps2;          ///< its time derivative
 };
@@ -34,11 +34,11 @@ class AnalyticTrajectory {
   /// The four quantities below at once; trajectories whose four share work override it
   /// (the truth generator calls it a dozen times per sample).
   virtual TrajectoryPoint PointAt(double t_s) const {
-    return {Euler_rad(t_s), EulerRate_rad_s(t_s), Velocity_n_mps(t_s), Acceleration_n_mps2(t_s)};
+    return {Euler_rad(t_s), EulerRate_radps(t_s), Velocity_n_mps(t_s), Acceleration_n_mps2(t_s)};
   }
   /// (roll, pitch, yaw) of R_n_b in rad and their time derivatives in rad/s.
   virtual Eigen::Vector3d Euler_rad(double t_s) const = 0;
-  virtual Eigen::Vector3d EulerRate_rad_s(double t_s) const = 0;
+  virtual Eigen::Vector3d EulerRate_radps(double t_s) const = 0;
   /// Velocity over the Earth in NED (m/s) and its time derivative (m/s^2).
   virtual Eigen::Vector3d Velocity_n_mps(double t_s) const = 0;
   virtual Eigen::Vector3d Acceleration_n_mps2(double t_s) const = 0;
@@ -46,7 +46,7 @@ class AnalyticTrajectory {
 
 /// Angular rate and specific force of the trajectory at time t for position (lat, h).
 struct BodyKinematics {
-  Eigen::Vector3d omega_ib_b_rad_s;
+  Eigen::Vector3d omega_ib_b_radps;
   Eigen::Vector3d f_b_mps2;
 };
 BodyKinematics BodyKinematicsAt(const AnalyticTrajectory& trajectory, double t_s, double lat_rad,
@@ -68,7 +68,7 @@ void SynthesizeImu(const AnalyticTrajectory& trajectory, const wgs84::Geodetic& 
 class DemoFlight : public AnalyticTrajectory {
  public:
   Eigen::Vector3d Euler_rad(double t_s) const override;
-  Eigen::Vector3d EulerRate_rad_s(double t_s) const override;
+  Eigen::Vector3d EulerRate_radps(double t_s) const override;
   Eigen::Vector3d Velocity_n_mps(double t_s) const override;
   Eigen::Vector3d Acceleration_n_mps2(double t_s) const override;
 };

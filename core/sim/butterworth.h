@@ -19,7 +19,7 @@
 
 #include <Eigen/Core>
 
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::sim {
 

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 namespace {
@@ -28,7 +29,6 @@ constexpr double kInSwingPlane = 1e-12;
 /// Angle step of the check that the roll stays on one branch over the swing.
 constexpr double kRollCheckStep_rad = 1e-3;
 /// Standard gravity (m/s^2) for the default c2 = g0 / length.
-constexpr double kG0_mps2 = 9.80665;
 
 // ------------------------------------------------------------- smooth profiles
 
@@ -92,7 +92,7 @@ TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
   }
   if (s.axis < 0) node.Fail("rotate", "expected roll, pitch or yaw, got '" + axis + "'");
   if (!node.Has("rate_deg_s")) node.Fail("rate_deg_s", "required for a rotation");
-  s.rate_rad_s =
+  s.rate_radps =
       node.Double("rate_deg_s", 0.0, -kMaxTableRate_deg_s, kMaxTableRate_deg_s) * kDegToRad;
   s.duration_s = node.Double("duration_s", 0.0, 0.0, kInf);
   s.ramp_s = node.Double("ramp_s", s.ramp_s, 0.0, kInf);
@@ -126,7 +126,7 @@ PendulumConfig ParsePendulum(const ConfigNode& node) {
     if (!(*c.c2_per_s2 > 0.0)) node.Fail("c2_per_s2", "must be > 0");
   }
   c.initial_angle_rad = node.Double("initial_angle_deg", 30.0, -179.0, 179.0) * kDegToRad;
-  c.initial_rate_rad_s = node.Double("initial_rate_deg_s", 0.0) * kDegToRad;
+  c.initial_rate_radps = node.Double("initial_rate_deg_s", 0.0) * kDegToRad;
   c.mounting_p_b = ParsePendulumMounting(node);
   c.angle_noise_rad = node.NonNegative("angle_noise_deg", 0.0) * kDegToRad;
   c.angle_quantum_rad = node.NonNegative("angle_quantum_deg", 0.0) * kDegToRad;
@@ -213,9 +213,9 @@ MultiPositionRig::MultiPositionRig(const MultiPositionConfig& config) {
         throw std::invalid_argument("MultiPositionRig: rotation needs ramp_s > 0, duration_s >= 0");
       }
       Eigen::Vector3d end = e;
-      end[step.axis] += step.rate_rad_s * (step.ramp_s + step.duration_s);
+      end[step.axis] += step.rate_radps * (step.ramp_s + step.duration_s);
       segments_.push_back({Segment::Kind::kSpin, t, t + 2.0 * step.ramp_s + step.duration_s, e, end,
-                           step.axis, step.rate_rad_s, step.ramp_s});
+                           step.axis, step.rate_radps, step.ramp_s});
       e = end;
     }
     t = segments_.empty() ? 0.0 : segments_.back().t1_s;
@@ -249,7 +249,7 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> MultiPositionRig::Evaluate(double t)
     case Segment::Kind::kMove:
       return {s.e0 + Smooth(tau / T) * (s.e1 - s.e0), SmoothRate(tau / T) / T * (s.e1 - s.e0)};
     case Segment::Kind::kSpin: {
-      const std::pair<double, double> spin = SpinProfile(s.rate_rad_s, s.ramp_s, T, tau);
+      const std::pair<double, double> spin = SpinProfile(s.rate_radps, s.ramp_s, T, tau);
       Eigen::Vector3d e = s.e0, de = Eigen::Vector3d::Zero();
       e[s.axis] += spin.first;
       de[s.axis] = spin.second;
@@ -265,7 +265,7 @@ TrajectoryPoint MultiPositionRig::PointAt(double t_s) const {
 }
 
 Eigen::Vector3d MultiPositionRig::Euler_rad(double t_s) const { return Evaluate(t_s).first; }
-Eigen::Vector3d MultiPositionRig::EulerRate_rad_s(double t_s) const { return Evaluate(t_s).second; }
+Eigen::Vector3d MultiPositionRig::EulerRate_radps(double t_s) const { return Evaluate(t_s).second; }
 
 void MultiPositionRig::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::BeginMap;
@@ -287,7 +287,7 @@ void MultiPositionRig::EmitDrawn(YAML::Emitter& out) const {
 PendulumRig::PendulumRig(const PendulumConfig& config)
     : config_(config),
       c1_(config.damping_per_s),
-      c2_(config.c2_per_s2.value_or(kG0_mps2 / config.length_m)),
+      c2_(config.c2_per_s2.value_or(kStandardGravity_mps2 / config.length_m)),
       node_step_s_(0.0),
       pivot_axis_b_(config.mounting_p_b.transpose().col(1)) {
   if (!(config.length_m > 0.0) || !(c1_ >= 0.0) || !(c2_ > 0.0) ||
@@ -295,7 +295,7 @@ PendulumRig::PendulumRig(const PendulumConfig& config)
     throw std::invalid_argument("PendulumRig: needs length_m > 0, c1 >= 0, c2 > 0, a rotation");
   }
   // Energy per unit inertia; at or above 2 c2 the pendulum would go over the top.
-  const double energy = 0.5 * config.initial_rate_rad_s * config.initial_rate_rad_s +
+  const double energy = 0.5 * config.initial_rate_radps * config.initial_rate_radps +
                         c2_ * (1.0 - std::cos(config.initial_angle_rad));
   if (!(energy < 2.0 * c2_ * (1.0 - 1e-9))) {
     throw std::invalid_argument("pendulum: the initial angle and rate make it go over the top");
@@ -309,7 +309,7 @@ PendulumRig::PendulumRig(const PendulumConfig& config)
   mount_roll_rad_ = std::atan2(-R(1, 2), R(1, 1));
   rest_roll_rad_ = EulerFromDcm(R).x();
   if (!planar_) RequireOneRollBranch(R, rest_roll_rad_, std::acos(1.0 - energy / c2_));
-  nodes_.push_back(Derivatives(config.initial_angle_rad, config.initial_rate_rad_s));
+  nodes_.push_back(Derivatives(config.initial_angle_rad, config.initial_rate_radps));
 }
 
 PendulumRig::Node PendulumRig::Derivatives(double theta, double rate) const {
@@ -400,7 +400,7 @@ TrajectoryPoint PendulumRig::PointAt(double t_s) const {
 
 Eigen::Vector3d PendulumRig::Euler_rad(double t_s) const { return EulerOf(Swing(t_s)); }
 
-Eigen::Vector3d PendulumRig::EulerRate_rad_s(double t_s) const {
+Eigen::Vector3d PendulumRig::EulerRate_radps(double t_s) const {
   const Node n = Swing(t_s);
   return EulerRateOf(n, EulerOf(n));
 }
@@ -418,7 +418,7 @@ void PendulumRig::EmitDrawn(YAML::Emitter& out) const {
   out << YAML::Key << "c1_per_s" << YAML::Value << c1_;
   out << YAML::Key << "c2_per_s2" << YAML::Value << c2_;
   out << YAML::Key << "initial_angle_deg" << YAML::Value << config_.initial_angle_rad * kRadToDeg;
-  out << YAML::Key << "initial_rate_deg_s" << YAML::Value << config_.initial_rate_rad_s * kRadToDeg;
+  out << YAML::Key << "initial_rate_deg_s" << YAML::Value << config_.initial_rate_radps * kRadToDeg;
   EmitMatrix(out, "mounting_p_b", config_.mounting_p_b);
   EmitVector(out, "pivot_axis_b", pivot_axis_b_);
   out << YAML::Key << "angle_noise_deg" << YAML::Value << config_.angle_noise_rad * kRadToDeg;

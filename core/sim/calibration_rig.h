@@ -28,7 +28,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/sim/analytic_trajectory.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::sim {
 
@@ -38,7 +38,7 @@ struct TableStep {
   Kind kind = Kind::kPosition;
   Eigen::Vector3d euler_rad = Eigen::Vector3d::Zero();  ///< position: (roll, pitch, yaw)
   int axis = 2;             ///< rotation: Euler angle turned, 0 roll, 1 pitch, 2 yaw
-  double rate_rad_s = 0.0;  ///< rotation: the constant rate (signed)
+  double rate_radps = 0.0;  ///< rotation: the constant rate (signed)
   double duration_s = 0.0;  ///< rotation: time at the constant rate
   double ramp_s = 1.0;      ///< rotation: spin-up time and spin-down time (> 0)
   double dwell_s = 0.0;     ///< hold after the step
@@ -56,7 +56,7 @@ struct PendulumConfig {
   double damping_per_s = 0.0;                     ///< c1 >= 0
   std::optional<double> c2_per_s2;                ///< default g0 / length_m (simple pendulum)
   double initial_angle_rad = 0.5235987755982988;  ///< 30 deg
-  double initial_rate_rad_s = 0.0;
+  double initial_rate_radps = 0.0;
   Eigen::Matrix3d mounting_p_b = Eigen::Matrix3d::Identity();  ///< R_p_b: IMU axes in the bob frame
   /// The pivot encoder (angle.csv of `navtwin simulate`): white noise (1 sigma) and the
   /// quantum of its absolute reading; 0: none.
@@ -104,7 +104,7 @@ class MultiPositionRig : public CalibrationRig {
   explicit MultiPositionRig(const MultiPositionConfig& config);
   TrajectoryPoint PointAt(double t_s) const override;
   Eigen::Vector3d Euler_rad(double t_s) const override;
-  Eigen::Vector3d EulerRate_rad_s(double t_s) const override;
+  Eigen::Vector3d EulerRate_radps(double t_s) const override;
   Eigen::Vector3d Velocity_n_mps(double) const override { return Eigen::Vector3d::Zero(); }
   Eigen::Vector3d Acceleration_n_mps2(double) const override { return Eigen::Vector3d::Zero(); }
   void EmitDrawn(YAML::Emitter& out) const override;
@@ -119,7 +119,7 @@ class MultiPositionRig : public CalibrationRig {
     double t0_s = 0.0, t1_s = 0.0;
     Eigen::Vector3d e0 = Eigen::Vector3d::Zero(), e1 = Eigen::Vector3d::Zero();
     int axis = 2;
-    double rate_rad_s = 0.0, ramp_s = 0.0;
+    double rate_radps = 0.0, ramp_s = 0.0;
   };
   /// (Euler angles, Euler rates) at t.
   std::pair<Eigen::Vector3d, Eigen::Vector3d> Evaluate(double t_s) const;
@@ -134,14 +134,14 @@ class PendulumRig : public CalibrationRig {
   explicit PendulumRig(const PendulumConfig& config);
   TrajectoryPoint PointAt(double t_s) const override;
   Eigen::Vector3d Euler_rad(double t_s) const override;
-  Eigen::Vector3d EulerRate_rad_s(double t_s) const override;
+  Eigen::Vector3d EulerRate_radps(double t_s) const override;
   Eigen::Vector3d Velocity_n_mps(double t_s) const override;
   Eigen::Vector3d Acceleration_n_mps2(double t_s) const override;
   void EmitDrawn(YAML::Emitter& out) const override;
 
   /// The pendulum angle theta (rad) and its first and second derivatives.
   double Angle_rad(double t_s) const { return Swing(t_s).theta; }
-  double AngleRate_rad_s(double t_s) const { return Swing(t_s).rate; }
+  double AngleRate_radps(double t_s) const { return Swing(t_s).rate; }
   double AngleAcceleration_rad_s2(double t_s) const { return Swing(t_s).accel; }
   double c1_per_s() const { return c1_; }
   double c2_per_s2() const { return c2_; }

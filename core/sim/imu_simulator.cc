@@ -46,10 +46,10 @@ std::optional<ImuSample> ImuSimulator::Push(const TruthSample& truth) {
     started_ = true;
     previous_ = truth;
     // Start the filters in the steady state of the initial rates: no start-up transient.
-    const Eigen::Vector3d w0 = R_imu_b_ * truth.omega_ib_b_rad_s;
+    const Eigen::Vector3d w0 = R_imu_b_ * truth.omega_ib_b_radps;
     if (gyro_filter_) gyro_filter_->Reset(w0);
     if (accel_filter_) {
-      const Eigen::Vector3d& w = truth.omega_ib_b_rad_s;
+      const Eigen::Vector3d& w = truth.omega_ib_b_radps;
       const Eigen::Vector3d& l = config_.lever_arm_b_m;
       accel_filter_->Reset(R_imu_b_ * (truth.f_b_mps2 + truth.alpha_ib_b_rad_s2.cross(l) +
                                        w.cross(w.cross(l))));
@@ -59,8 +59,8 @@ std::optional<ImuSample> ImuSimulator::Push(const TruthSample& truth) {
   const double t0 = previous_.t_s, t1 = truth.t_s, h = t1 - t0;
   const Eigen::Vector3d& l = config_.lever_arm_b_m;
   // 1. Lever arm (body axes): the alpha x l term integrates exactly to d(omega) x l.
-  const Eigen::Vector3d& w0 = previous_.omega_ib_b_rad_s;
-  const Eigen::Vector3d& w1 = truth.omega_ib_b_rad_s;
+  const Eigen::Vector3d& w0 = previous_.omega_ib_b_radps;
+  const Eigen::Vector3d& w1 = truth.omega_ib_b_radps;
   Eigen::Vector3d dv_b = truth.exact.dv_b_mps + (w1 - w0).cross(l) +
                          0.5 * h * (w0.cross(w0.cross(l)) + w1.cross(w1.cross(l)));
   Eigen::Vector3d dtheta = R_imu_b_ * truth.exact.dtheta_b_rad;

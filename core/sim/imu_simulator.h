@@ -22,7 +22,7 @@
 #include "core/sim/random.h"
 #include "core/sim/truth.h"
 #include "core/sim/vibration.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::sim {
 

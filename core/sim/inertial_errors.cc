@@ -6,17 +6,12 @@
 #include <stdexcept>
 
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kG_mps2 = 9.80665;  // standard gravity, the "g" of ug and deg/h/g
-constexpr double kMicroG_mps2 = 1e-6 * kG_mps2;
-constexpr double kDegPerHour_radps = kDegToRad / 3600.0;
-constexpr double kArcsec_rad = kDegToRad / 3600.0;
-constexpr double kPpm = 1e-6;
-constexpr double kSqrtHour_sqrts = 60.0;  // sqrt(1 h) = 60 sqrt(s)
 
 /// How one triad's quantities are named and scaled in YAML (parsing and errors.yaml
 /// share this table, so the two cannot disagree). `*_si` converts a YAML value to SI.
@@ -209,7 +204,7 @@ InertialErrorConfig ParseInertialErrorConfig(const ConfigNode& node) {
   c.gyro = ParseTriad(node.Child("gyro"), GyroUnits());
   c.accel = ParseTriad(node.Child("accel"), AccelUnits());
   c.g_sensitivity = ParseMatrixConstant(node, "g_sensitivity_deg_h_per_g", "g_sensitivity_fixed_deg_h_per_g",
-                                        kDegPerHour_radps / kG_mps2);
+                                        kDegPerHour_radps / kStandardGravity_mps2);
   c.temperature = ParseTemperatureProfile(node.Child("temperature_profile"));
   return c;
 }
@@ -352,7 +347,7 @@ void InertialErrorModel::EmitDrawn(YAML::Emitter& out) const {
   EmitTriad(out, gyro_, GyroUnits());
   out << YAML::Key << "accel" << YAML::Value;
   EmitTriad(out, accel_, AccelUnits());
-  EmitMatrix(out, "g_sensitivity_deg_h_per_g", g_sensitivity_, kDegPerHour_radps / kG_mps2);
+  EmitMatrix(out, "g_sensitivity_deg_h_per_g", g_sensitivity_, kDegPerHour_radps / kStandardGravity_mps2);
   out << YAML::EndMap;
 }
 

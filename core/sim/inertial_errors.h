@@ -21,7 +21,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/sim/random.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::sim {
 

@@ -28,7 +28,7 @@ InitErrorConfig ParseInitErrors(const ConfigNode& node) {
     node.Fail("attitude_arcmin", "give attitude_deg or attitude_arcmin, not both");
   }
   c.attitude_phi_n_rad = node.Vector("attitude_deg", Eigen::Vector3d::Zero()) * kDegToRad +
-                         node.Vector("attitude_arcmin", Eigen::Vector3d::Zero()) * kDegToRad / 60.0;
+                         node.Vector("attitude_arcmin", Eigen::Vector3d::Zero()) * kArcmin_rad;
   return c;
 }
 
@@ -57,7 +57,7 @@ Scenario ParseScenario(const ConfigNode& root) {
     trajectory.Fail("kind", "unknown trajectory kind '" + kind +
                                 "' (segments, multiposition, pendulum)");
   }
-  s.duration_s = root.Double("duration_s", trajectory_duration_s, 0.0, 30.0 * 86400.0);
+  s.duration_s = root.Double("duration_s", trajectory_duration_s, 0.0, 30.0 * kSecondsPerDay);
   if (!(s.duration_s > 0.0)) root.Fail("duration_s", "required (> 0) for this trajectory kind");
   s.imu = ParseImuSimConfig(root.Child("imu"));
   if (root.Has("gnss")) s.gnss = ParseGnssSimConfig(root.Child("gnss"));

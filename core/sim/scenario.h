@@ -13,7 +13,7 @@
 #include "core/sim/aiding.h"
 #include "core/sim/analytic_trajectory.h"
 #include "core/sim/imu_simulator.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::sim {
 

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 namespace {
@@ -20,7 +21,6 @@ using detail::SegmentPlan;
 
 // Standard gravity for the coordinated-turn bank atan(V psi' / g0): the bank is a shape
 // chosen for the trajectory, so a fixed g keeps it independent of position.
-constexpr double kG0_mps2 = 9.80665;
 // A static or hover segment needs speed 0 at its start; a deceleration computed to end at
 // 0 may leave rounding of this size.
 constexpr double kRestSpeedTolerance_mps = 1e-9;
@@ -77,7 +77,7 @@ Jet OscillationAt(const ChannelProfile& p, double tau, double duration_s) {
     const Smoothstep s = Septic((duration_s - tau) / p.fade_s);
     envelope = {s.value, -s.slope / p.fade_s, s.curvature / (p.fade_s * p.fade_s)};
   }
-  const double w = p.omega_rad_s;
+  const double w = p.omega_radps;
   const double sine = p.amplitude * std::sin(w * tau), cosine = p.amplitude * std::cos(w * tau);
   return {envelope.value * sine, envelope.rate * sine + envelope.value * w * cosine,
           envelope.accel * sine + 2.0 * envelope.rate * w * cosine - envelope.value * w * w * sine};
@@ -205,11 +205,11 @@ class Planner {
 
   void PlanHover(const SegmentConfig& seg, double transition_s, SegmentPlan& plan) {
     RequireRest("hover");
-    if (seg.yaw_rate_rad_s == 0.0) return;
+    if (seg.yaw_rate_radps == 0.0) return;
     ChannelProfile& p = plan.profile[detail::kHeading];
     p.ramp_s = std::min(transition_s, 0.5 * seg.duration_s);
     p.active_s = seg.duration_s;
-    p.plateau = seg.yaw_rate_rad_s;
+    p.plateau = seg.yaw_rate_radps;
     state_[detail::kHeading] += TrapezoidChange(p);
   }
 
@@ -280,14 +280,14 @@ class Planner {
 
   void PlanTurn(const SegmentConfig& seg, double transition_s, SegmentPlan& plan) {
     const double change = seg.heading_change_rad;
-    if (seg.turn_rate_rad_s && !(*seg.turn_rate_rad_s > 0.0)) {
+    if (seg.turn_rate_radps && !(*seg.turn_rate_radps > 0.0)) {
       Reject("turn_rate_deg_s", "must be > 0 (a magnitude; the sign of the change turns)");
     }
     if (change == 0.0) return;
-    if (!seg.turn_rate_rad_s) {
+    if (!seg.turn_rate_radps) {
       plan.profile[detail::kHeading] = Spread(change, seg.duration_s, transition_s);
     } else {
-      const double rate = *seg.turn_rate_rad_s, at_rate_s = std::abs(change) / rate;
+      const double rate = *seg.turn_rate_radps, at_rate_s = std::abs(change) / rate;
       ChannelProfile& p = plan.profile[detail::kHeading];
       p.ramp_s = std::min(transition_s, at_rate_s);
       p.active_s = at_rate_s + p.ramp_s;
@@ -305,7 +305,7 @@ class Planner {
     if (!(seg.period_s > 0.0)) Reject("period_s", "must be > 0");
     ChannelProfile& p = plan.profile[detail::kHeading];
     p.amplitude = seg.heading_amplitude_rad;
-    p.omega_rad_s = 2.0 * M_PI / seg.period_s;
+    p.omega_radps = 2.0 * M_PI / seg.period_s;
     p.fade_s = std::min(transition_s, 0.5 * seg.duration_s);
   }
 
@@ -319,7 +319,7 @@ class Planner {
       if (!(f > 0.0)) Reject(name + "_frequency_hz", "must be > 0 when the amplitude is not 0");
       ChannelProfile& p = plan.profile[detail::kRollOverlay + axis];
       p.amplitude = amplitude;
-      p.omega_rad_s = 2.0 * M_PI * f;
+      p.omega_radps = 2.0 * M_PI * f;
       p.fade_s = std::min(transition_s, 0.5 * seg.duration_s);
     }
     if (!(std::abs(state_[detail::kFlightPath]) + std::abs(state_[detail::kPitchOverlay]) +
@@ -421,7 +421,7 @@ SegmentConfig ParseSegment(const ConfigNode& n) {
   if (s.kind == SegmentKind::kTurn) {
     s.heading_change_rad = kDegToRad * n.RequiredDouble("heading_change_deg");
   }
-  s.turn_rate_rad_s = OptionalDouble(n, "turn_rate_deg_s", kDegToRad);
+  s.turn_rate_radps = OptionalDouble(n, "turn_rate_deg_s", kDegToRad);
   if (s.kind == SegmentKind::kSTurns) {
     s.heading_amplitude_rad = kDegToRad * n.RequiredDouble("heading_amplitude_deg");
     s.period_s = n.RequiredDouble("period_s");
@@ -432,7 +432,7 @@ SegmentConfig ParseSegment(const ConfigNode& n) {
   s.frequency_hz =
       Eigen::Vector3d(n.Double("roll_frequency_hz", 0.0), n.Double("pitch_frequency_hz", 0.0),
                       n.Double("yaw_frequency_hz", 0.0));
-  s.yaw_rate_rad_s = kDegToRad * n.Double("yaw_rate_deg_s", 0.0);
+  s.yaw_rate_radps = kDegToRad * n.Double("yaw_rate_deg_s", 0.0);
   s.level = n.Bool("level", true);
   return s;
 }
@@ -513,7 +513,7 @@ using Channels = SegmentTrajectory::Channels;
 
 Eigen::Vector3d EulerOf(const Channels& c) {
   using namespace detail;
-  const double bank = std::atan(c.value[kSpeed] * c.rate[kHeading] / kG0_mps2);
+  const double bank = std::atan(c.value[kSpeed] * c.rate[kHeading] / kStandardGravity_mps2);
   return {bank + c.value[kRollOverlay], c.value[kFlightPath] + c.value[kPitchOverlay],
           c.value[kHeading] + c.value[kYawOverlay]};
 }
@@ -521,9 +521,9 @@ Eigen::Vector3d EulerOf(const Channels& c) {
 Eigen::Vector3d EulerRateOf(const Channels& c) {
   using namespace detail;
   // d/dt atan(q) with q = V psi' / g0.
-  const double q = c.value[kSpeed] * c.rate[kHeading] / kG0_mps2;
+  const double q = c.value[kSpeed] * c.rate[kHeading] / kStandardGravity_mps2;
   const double dq =
-      (c.rate[kSpeed] * c.rate[kHeading] + c.value[kSpeed] * c.accel[kHeading]) / kG0_mps2;
+      (c.rate[kSpeed] * c.rate[kHeading] + c.value[kSpeed] * c.accel[kHeading]) / kStandardGravity_mps2;
   return {dq / (1.0 + q * q) + c.rate[kRollOverlay], c.rate[kFlightPath] + c.rate[kPitchOverlay],
           c.rate[kHeading] + c.rate[kYawOverlay]};
 }
@@ -550,7 +550,7 @@ Eigen::Vector3d AccelerationOf(const Channels& c) {
 }  // namespace
 
 Eigen::Vector3d SegmentTrajectory::Euler_rad(double t_s) const { return EulerOf(Evaluate(t_s)); }
-Eigen::Vector3d SegmentTrajectory::EulerRate_rad_s(double t_s) const {
+Eigen::Vector3d SegmentTrajectory::EulerRate_radps(double t_s) const {
   return EulerRateOf(Evaluate(t_s));
 }
 Eigen::Vector3d SegmentTrajectory::Velocity_n_mps(double t_s) const {

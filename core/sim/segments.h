@@ -24,7 +24,7 @@
 #include <Eigen/Core>
 
 #include "core/sim/analytic_trajectory.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::sim {
 
@@ -53,9 +53,9 @@ struct SegmentConfig {
   std::optional<double> flight_path_rad;
   std::optional<double> vertical_speed_mps;
   // turn: signed heading change (positive clockwise seen from above, i.e. to the right)
-  // at turn_rate_rad_s (magnitude > 0), or spread over the whole segment when absent.
+  // at turn_rate_radps (magnitude > 0), or spread over the whole segment when absent.
   double heading_change_rad = 0.0;
-  std::optional<double> turn_rate_rad_s;
+  std::optional<double> turn_rate_radps;
   // s_turns: heading amplitude and period.
   double heading_amplitude_rad = 0.0;
   double period_s = 0.0;
@@ -63,7 +63,7 @@ struct SegmentConfig {
   Eigen::Vector3d amplitude_rad = Eigen::Vector3d::Zero();
   Eigen::Vector3d frequency_hz = Eigen::Vector3d::Zero();
   // hover: yaw rate.
-  double yaw_rate_rad_s = 0.0;
+  double yaw_rate_radps = 0.0;
   // cruise: true brings the flight-path angle to 0, false holds the current state.
   bool level = true;
 };
@@ -94,7 +94,7 @@ struct ChannelProfile {
   double plateau = 0.0, ramp_s = 0.0, active_s = 0.0;
   // Oscillation amplitude * sin(omega * tau) under an envelope faded in over fade_s after
   // the segment start and out over fade_s before its end (it ends where it started).
-  double amplitude = 0.0, omega_rad_s = 0.0, fade_s = 0.0;
+  double amplitude = 0.0, omega_radps = 0.0, fade_s = 0.0;
 };
 /// Channels: speed, heading, flight-path angle, roll/pitch/yaw overlays.
 enum Channel { kSpeed, kHeading, kFlightPath, kRollOverlay, kPitchOverlay, kYawOverlay };
@@ -112,7 +112,7 @@ class SegmentTrajectory : public AnalyticTrajectory {
   explicit SegmentTrajectory(const TrajectoryConfig& config);
 
   Eigen::Vector3d Euler_rad(double t_s) const override;
-  Eigen::Vector3d EulerRate_rad_s(double t_s) const override;
+  Eigen::Vector3d EulerRate_radps(double t_s) const override;
   Eigen::Vector3d Velocity_n_mps(double t_s) const override;
   Eigen::Vector3d Acceleration_n_mps2(double t_s) const override;
   TrajectoryPoint PointAt(double t_s) const override;

@@ -41,8 +41,8 @@ TruthGenerator::TruthGenerator(const AnalyticTrajectory& trajectory, const wgs84
   // At the start, a one-sided difference over 1e-4 s (trajectories are defined for t >= 0).
   constexpr double kDiffStep_s = 1e-4;
   current_.alpha_ib_b_rad_s2 =
-      (BodyKinematicsAt(trajectory_, kDiffStep_s, start.lat_rad, start.h_m).omega_ib_b_rad_s -
-       current_.omega_ib_b_rad_s) / kDiffStep_s;
+      (BodyKinematicsAt(trajectory_, kDiffStep_s, start.lat_rad, start.h_m).omega_ib_b_radps -
+       current_.omega_ib_b_radps) / kDiffStep_s;
 }
 
 TruthSample TruthGenerator::Sample(double t, const wgs84::Geodetic& p) const {
@@ -57,7 +57,7 @@ TruthSample TruthGenerator::Sample(double t, const wgs84::Geodetic& p) const {
   const Eigen::Vector3d& e = point.euler_rad;
   s.state.q_n_b = QuatFromEuler(e.x(), e.y(), e.z());
   const BodyKinematics k = BodyKinematicsAt(point, p.lat_rad, p.h_m);
-  s.omega_ib_b_rad_s = k.omega_ib_b_rad_s;
+  s.omega_ib_b_radps = k.omega_ib_b_radps;
   s.f_b_mps2 = k.f_b_mps2;
   s.a_n_mps2 = point.a_n_mps2;
   s.exact.t_s = t;
@@ -82,9 +82,9 @@ const TruthSample& TruthGenerator::Next() {
     position_ = Rk4(trajectory_, position_, t, tn - t);
     t = tn;
     const BodyKinematics kin = BodyKinematicsAt(trajectory_, tn, position_.lat_rad, position_.h_m);
-    inc.dtheta_b_rad += weights[i] * dt_s_ * kin.omega_ib_b_rad_s;
+    inc.dtheta_b_rad += weights[i] * dt_s_ * kin.omega_ib_b_radps;
     inc.dv_b_mps += weights[i] * dt_s_ * kin.f_b_mps2;
-    omega_nodes[i] = kin.omega_ib_b_rad_s;
+    omega_nodes[i] = kin.omega_ib_b_radps;
   }
   position_ = Rk4(trajectory_, position_, t, t1 - t);
   ++k_;
@@ -95,7 +95,7 @@ const TruthSample& TruthGenerator::Next() {
   const double x0 = t0 + nodes[1] * dt_s_, x1 = t0 + nodes[2] * dt_s_, x2 = t1;
   current_.alpha_ib_b_rad_s2 = omega_nodes[1] * ((x2 - x1) / ((x0 - x1) * (x0 - x2))) +
                                omega_nodes[2] * ((x2 - x0) / ((x1 - x0) * (x1 - x2))) +
-                               current_.omega_ib_b_rad_s * ((2 * x2 - x0 - x1) / ((x2 - x0) * (x2 - x1)));
+                               current_.omega_ib_b_radps * ((2 * x2 - x0 - x1) / ((x2 - x0) * (x2 - x1)));
   return current_;
 }
 

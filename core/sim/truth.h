@@ -13,7 +13,7 @@ namespace navtwin::sim {
 struct TruthSample {
   double t_s = 0.0;
   NavState state;                                            ///< position, velocity, attitude at t_s
-  Eigen::Vector3d omega_ib_b_rad_s = Eigen::Vector3d::Zero();  ///< angular rate at t_s
+  Eigen::Vector3d omega_ib_b_radps = Eigen::Vector3d::Zero();  ///< angular rate at t_s
   Eigen::Vector3d f_b_mps2 = Eigen::Vector3d::Zero();          ///< specific force at t_s
   Eigen::Vector3d alpha_ib_b_rad_s2 = Eigen::Vector3d::Zero(); ///< d(omega_ib_b)/dt at t_s
   Eigen::Vector3d a_n_mps2 = Eigen::Vector3d::Zero();          ///< d(v_n)/dt at t_s

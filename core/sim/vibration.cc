@@ -69,8 +69,8 @@ VibrationToneConfig ParseTone(const ConfigNode& node) {
   if (!node.Has("frequency_hz")) node.Fail("frequency_hz", "required ([lo, hi] in Hz)");
   tone.frequency_hz = node.Range("frequency_hz", Eigen::Vector2d::Zero());
   if (!(tone.frequency_hz[0] > 0.0)) node.Fail("frequency_hz", "must be > 0");
-  tone.linear_g = node.Double("linear_g", 0.0, 0.0, 1e6);
-  tone.angular_deg_s = node.Double("angular_deg_s", 0.0, 0.0, 1e9);
+  tone.linear_mps2 = node.Double("linear_g", 0.0, 0.0, 1e6) * kStandardGravity_mps2;
+  tone.angular_radps = node.Double("angular_deg_s", 0.0, 0.0, 1e9) * kDegPerSecond_radps;
   const std::string amplitude = node.String("amplitude", "normal");
   if (amplitude != "normal" && amplitude != "fixed") {
     node.Fail("amplitude", "expected normal or fixed, got '" + amplitude + "'");
@@ -94,8 +94,7 @@ double CycleFraction(double f_hz, double t_s) {
 // (drawn or fixed) shared by the harmonics through their gains, and a phase per harmonic.
 void DrawKind(const VibrationToneConfig& config, int group, bool angular, double fundamental_hz,
               const Rng& group_rng, std::vector<VibrationTone>* tones) {
-  const double value = angular ? config.angular_deg_s * kDegToRad
-                               : config.linear_g * kStandardGravity_mps2;
+  const double value = angular ? config.angular_radps : config.linear_mps2;
   if (value == 0.0) return;
   const std::string kind = angular ? "angular" : "linear";
   Rng amplitude_rng = group_rng.Stream(kind);
@@ -157,12 +156,12 @@ void VibrationModel::Increment(double t0_s, double t1_s, Eigen::Vector3d* dtheta
   }
 }
 
-void VibrationModel::Rate(double t_s, Eigen::Vector3d* omega_rad_s, Eigen::Vector3d* f_mps2) const {
-  omega_rad_s->setZero();
+void VibrationModel::Rate(double t_s, Eigen::Vector3d* omega_radps, Eigen::Vector3d* f_mps2) const {
+  omega_radps->setZero();
   f_mps2->setZero();
   for (const VibrationTone& tone : tones_) {
     const double phase = 2.0 * M_PI * CycleFraction(tone.frequency_hz, t_s) + tone.phase_rad;
-    (tone.angular ? *omega_rad_s : *f_mps2)[tone.axis] += tone.amplitude * std::sin(phase);
+    (tone.angular ? *omega_radps : *f_mps2)[tone.axis] += tone.amplitude * std::sin(phase);
   }
 }
 

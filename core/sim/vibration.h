@@ -29,7 +29,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/sim/random.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 
@@ -37,8 +38,8 @@ namespace navtwin::sim {
 struct VibrationToneConfig {
   std::array<bool, 3> axes{{false, false, false}};  ///< body x, y, z (FRD)
   Eigen::Vector2d frequency_hz{0.0, 0.0};           ///< range of the fundamental
-  double linear_g = 0.0;                            ///< specific-force amplitude (g)
-  double angular_deg_s = 0.0;                       ///< angular-rate amplitude (deg/s)
+  double linear_mps2 = 0.0;                         ///< specific-force amplitude (key linear_g)
+  double angular_radps = 0.0;                       ///< angular-rate amplitude (key angular_deg_s)
   bool random_amplitude = true;  ///< amplitudes are 1-sigma of a zero-mean normal draw
   std::vector<double> harmonic_gains{1.0};  ///< relative amplitude of harmonic k = 1..n
 };
@@ -76,7 +77,7 @@ class VibrationModel {
   void Increment(double t0_s, double t1_s, Eigen::Vector3d* dtheta_rad,
                  Eigen::Vector3d* dv_mps) const;
   /// The vibration's angular rate (rad/s) and specific force (m/s^2) at t_s.
-  void Rate(double t_s, Eigen::Vector3d* omega_rad_s, Eigen::Vector3d* f_mps2) const;
+  void Rate(double t_s, Eigen::Vector3d* omega_radps, Eigen::Vector3d* f_mps2) const;
 
   /// The drawn tones as a YAML map {tones: [{group, harmonic, axis, kind, frequency_hz,
   /// amplitude_g | amplitude_deg_s, phase_rad}, ...]}.
@@ -87,8 +88,5 @@ class VibrationModel {
  private:
   std::vector<VibrationTone> tones_;
 };
-
-/// Standard gravity (m/s^2, CGPM 1901), the "g" of amplitudes given in g.
-constexpr double kStandardGravity_mps2 = 9.80665;
 
 }  // namespace navtwin::sim

@@ -10,6 +10,7 @@
 
 #include "core/io/csv_imu.h"
 #include "core/io/json_writer.h"
+#include "core/units.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -33,8 +34,6 @@ struct Row {
   const char* unit = "";
 };
 
-constexpr double kRadPerSToDegPerH = 180.0 / M_PI * 3600.0;
-constexpr double kMps2ToMg = 1000.0 / kStandardGravity_mps2;
 
 double SigmaOr(const std::optional<Eigen::Matrix<double, kTriadParameters, 1>>& s, int i) {
   return s ? (*s)(i) : std::numeric_limits<double>::quiet_NaN();
@@ -51,7 +50,7 @@ std::vector<Row> Rows(const ImuCalibration& c) {
       r.value = v(i);
       r.sigma = SigmaOr(s, i);
       if (i < 3) {
-        r.per_si = 1e6;
+        r.per_si = 1.0 / kPpm;
         r.unit = "ppm";
       } else if (i < 9) {
         r.per_si = 1e3;
@@ -63,14 +62,14 @@ std::vector<Row> Rows(const ImuCalibration& c) {
       rows.push_back(r);
     }
   };
-  triad("accel", c.accel, c.accel_sigma, kMps2ToMg, "mg");
-  triad("gyro", c.gyro, c.gyro_sigma, kRadPerSToDegPerH, "deg/h");
+  triad("accel", c.accel, c.accel_sigma, 1.0 / kMilliG_mps2, "mg");
+  triad("gyro", c.gyro, c.gyro_sigma, 1.0 / kDegPerHour_radps, "deg/h");
   for (int i = 0; i < kGSensitivityParameters; ++i) {
     Row r;
     r.name = GSensitivityParameterName(i);
     r.value = c.g_sensitivity(i);
     r.sigma = c.g_sensitivity_sigma ? (*c.g_sensitivity_sigma)(i) : std::numeric_limits<double>::quiet_NaN();
-    r.per_si = kRadPerSToDegPerH * kStandardGravity_mps2;
+    r.per_si = kStandardGravity_mps2 / kDegPerHour_radps;
     r.unit = "deg/h/g";
     rows.push_back(r);
   }
@@ -107,10 +106,10 @@ std::vector<Row> TemperatureRows(const ImuCalibrationResult& result) {
       }
     }
   };
-  terms("accel.scale_factor.", t.accel_scale_factor, 1e6, "ppm/degC^k");
-  terms("accel.bias.", t.accel_bias_mps2, kMps2ToMg, "mg/degC^k");
-  terms("gyro.scale_factor.", t.gyro_scale_factor, 1e6, "ppm/degC^k");
-  terms("gyro.bias.", t.gyro_bias_rad_per_s, kRadPerSToDegPerH, "deg/h/degC^k");
+  terms("accel.scale_factor.", t.accel_scale_factor, 1.0 / kPpm, "ppm/degC^k");
+  terms("accel.bias.", t.accel_bias_mps2, 1.0 / kMilliG_mps2, "mg/degC^k");
+  terms("gyro.scale_factor.", t.gyro_scale_factor, 1.0 / kPpm, "ppm/degC^k");
+  terms("gyro.bias.", t.gyro_bias_rad_per_s, 1.0 / kDegPerHour_radps, "deg/h/degC^k");
   return rows;
 }
 
@@ -198,7 +197,7 @@ std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::st
     for (const std::string& u : result.unobservable) out << "  " << u << "\n";
   }
   std::snprintf(line, sizeof(line), "residual rms: accel %.4g mg, gyro %.4g deg/h\n",
-                result.accel_residual_rms_mps2 * kMps2ToMg, result.gyro_residual_rms_rad_per_s * kRadPerSToDegPerH);
+                result.accel_residual_rms_mps2 / kMilliG_mps2, result.gyro_residual_rms_rad_per_s / kDegPerHour_radps);
   out << line;
   for (const std::string& n : result.notes) out << "note: " << n << "\n";
   return out.str();

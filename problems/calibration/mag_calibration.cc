@@ -20,7 +20,7 @@
 #include <Eigen/LU>
 
 #include "core/rotation.h"
-#include "factors/mag_ellipsoid.h"
+#include "problems/calibration/mag_ellipsoid.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -275,7 +275,7 @@ double FieldMagnitudeSpread_uT(const std::vector<MagSample>& samples) {
 }
 
 Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector3d& m_uT) {
-  return c.correction * (m_uT - c.hard_iron_uT);
+  return RemoveIron(m_uT, c.hard_iron_uT, c.correction);
 }
 
 // ------------------------------------------------------------------------ batch ellipsoid
@@ -470,7 +470,7 @@ MagCalibration RecursiveEllipsoidFit::Current() const {
 //    mean of the semi-axes) and A2 = R A_unit, centre s c.
 // 3. geometric least squares r_i = |A2 (p_i - c)| - R with R held (MagEllipsoid on (p, 0)
 //    with h_z and A's third row/column held: the same residual in 2-D), robust loss.
-// 4. checks: A2 positive definite; the directions A2 (p_i - c) cover >= min_coverage_deg;
+// 4. checks: A2 positive definite; the directions A2 (p_i - c) cover >= min_coverage_rad;
 //    the axis ratio of A2 <= kMaxCorrectionAxisRatio; sigma(c) <= kMaxHardIronSigmaFraction R.
 // 5. lift to sensor axes: h = U (U^T m_bar + c) (no component along n),
 //    A = U A2 U^T + n n^T (identity along n); sigmas propagated from the 5x5 sandwich
@@ -480,8 +480,8 @@ MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitO
     throw std::invalid_argument("FitPlanar: loss_scale_uT must be positive and finite");
   }
   if (options.max_iterations < 1) throw std::invalid_argument("FitPlanar: max_iterations must be >= 1");
-  if (!(options.min_coverage_deg > 0.0 && options.min_coverage_deg <= 360.0)) {
-    throw std::invalid_argument("FitPlanar: min_coverage_deg must be in (0, 360]");
+  if (!(options.min_coverage_rad > 0.0 && options.min_coverage_rad <= kTwoPi)) {
+    throw std::invalid_argument("FitPlanar: min_coverage_rad must be in (0, 2 pi]");
   }
   if (!(options.max_out_of_plane > 0.0) || !std::isfinite(options.max_out_of_plane)) {
     throw std::invalid_argument("FitPlanar: max_out_of_plane must be positive and finite");
@@ -579,9 +579,9 @@ MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitO
     angles.push_back(std::atan2(d.y(), d.x()));
   }
   const double coverage_deg = 360.0 - LargestGap(angles) * kRadToDeg;
-  if (coverage_deg < options.min_coverage_deg) {
+  if (coverage_deg * kDegToRad < options.min_coverage_rad) {
     throw std::runtime_error("FitPlanar: the in-plane field directions cover only " + std::to_string(coverage_deg) +
-                             " deg of the circle (need " + std::to_string(options.min_coverage_deg) +
+                             " deg of the circle (need " + std::to_string(options.min_coverage_rad * kRadToDeg) +
                              "): turn through a full 360 deg in the plane");
   }
 
@@ -672,11 +672,11 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
     throw std::invalid_argument("FitBidirectional: " + std::to_string(samples.size()) + " samples but " +
                                 std::to_string(roll_pitch_rad.size()) + " roll/pitch pairs");
   }
-  if (!(options.max_tilt_deg > 0.0) || !std::isfinite(options.max_tilt_deg)) {
-    throw std::invalid_argument("FitBidirectional: max_tilt_deg must be positive and finite");
+  if (!(options.max_tilt_rad > 0.0) || !std::isfinite(options.max_tilt_rad)) {
+    throw std::invalid_argument("FitBidirectional: max_tilt_rad must be positive and finite");
   }
   CheckSamplesFinite(samples, "FitBidirectional");
-  const double max_tilt_rad = options.max_tilt_deg * kDegToRad;
+  const double max_tilt_rad = options.max_tilt_rad;
   std::vector<Eigen::Vector2d> xy;
   std::vector<MagSample> used;
   for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -690,7 +690,7 @@ MagCalibration FitBidirectional(const std::vector<MagSample>& samples, const std
   }
   if (static_cast<int>(xy.size()) < kMinBidirectionalSamples) {
     throw std::runtime_error("FitBidirectional: too few samples within the tilt limit of " +
-                             std::to_string(options.max_tilt_deg) + " deg: " + std::to_string(xy.size()) + " of " +
+                             std::to_string(options.max_tilt_rad * kRadToDeg) + " deg: " + std::to_string(xy.size()) + " of " +
                              std::to_string(samples.size()) + " (need at least " +
                              std::to_string(kMinBidirectionalSamples) + ")");
   }

@@ -1,7 +1,8 @@
 // Magnetometer calibration (seed 001 section 3, issue 8): hard and soft iron.
 //
-// Sensor model (the simulator's, core/sim/aiding.h): m = (I + S) m_b + h + n, with m_b the
-// Earth field in body axes (|m_b| = B everywhere), S the soft iron, h the hard iron, n noise.
+// Sensor model (core/mag_iron_model.h, as the simulator draws it): m = (I + S) m_b + h + n,
+// with m_b the Earth field in body axes (|m_b| = B everywhere), S the soft iron, h the hard
+// iron, n noise.
 // Calibration: m_b ~ A (m - h), A = (I + S)^-1 up to a rotation; A is estimated SYMMETRIC
 // (6 unknowns: the rotation part of (I + S)^-1 cannot be seen from magnitudes alone and is
 // the IMU-to-magnetometer alignment, not iron), h has 3, and the field magnitude B is fixed
@@ -38,7 +39,9 @@
 
 #include <Eigen/Core>
 
+#include "core/mag_iron_model.h"
 #include "core/types.h"
+#include "core/units.h"
 
 namespace navtwin::calibration {
 
@@ -108,10 +111,10 @@ struct PlanarFitOptions {
   MagLoss loss = MagLoss::kCauchy;
   double loss_scale_uT = 2.0;
   int max_iterations = 50;
-  /// Smallest accepted angle covered by the in-plane directions (deg): with a gap below
+  /// Smallest accepted angle covered by the in-plane directions (rad): with a gap below
   /// 90 deg, at most one of the four extremes of any pair of in-plane axes is unseen, so
   /// both extremes of one axis and at least one of the other bound the centre and the shape.
-  double min_coverage_deg = 270.0;
+  double min_coverage_rad = 270.0 * kDegToRad;
   /// Largest accepted RMS distance from the plane as a fraction of the in-plane radius R:
   /// a tilt t about a horizontal axis at a random angle moves a sample out of the plane by
   /// R t / sqrt(2) RMS, so 0.15 is ~12 deg of tilt (a heading error of ~18 deg at 57 deg
@@ -127,7 +130,7 @@ struct PlanarFitOptions {
 MagCalibration FitPlanar(const std::vector<MagSample>& samples, const PlanarFitOptions& options = {});
 
 struct BidirectionalOptions {
-  double max_tilt_deg = 2.0;  ///< samples with |roll| or |pitch| above this are left out
+  double max_tilt_rad = 2.0 * kDegToRad;  ///< samples with |roll| or |pitch| above this are left out
 };
 
 /// 2-axis (x, y) calibration from samples taken during a level turn through at least 360

@@ -21,7 +21,7 @@
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
-#include "factors/imu_calibration_residuals.h"
+#include "problems/calibration/imu_calibration_residuals.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -37,7 +37,7 @@ using MatrixP = Eigen::Matrix<double, kAll, kAll>;
 /// Per-sample scatter floors (noise-free data): they only set the relative weight of the
 /// accelerometer and gyro residuals, in the ratio of a good tactical IMU's noise.
 constexpr double kAccelScatterFloor_mps2 = 1e-7;
-constexpr double kGyroScatterFloor_rad_s = 1e-9;
+constexpr double kGyroScatterFloor_radps = 1e-9;
 /// A direction of the column-normalised information matrix with a relative eigenvalue
 /// below this is not observed (condition number 1e10: sigma amplified by 1e5).
 constexpr double kNullEigenvalueRatio = 1e-10;
@@ -201,7 +201,7 @@ Residuals BuildResiduals(const MultiPositionData& data, const MultiPositionOptio
   const Eigen::Vector3d s_a = dof > 0.0 ? Eigen::Vector3d((ss_a / dof).cwiseSqrt()) : Eigen::Vector3d::Zero();
   const Eigen::Vector3d s_g = dof > 0.0 ? Eigen::Vector3d((ss_g / dof).cwiseSqrt()) : Eigen::Vector3d::Zero();
   const Eigen::Vector3d sa = s_a.cwiseMax(kAccelScatterFloor_mps2);
-  const Eigen::Vector3d sg = s_g.cwiseMax(kGyroScatterFloor_rad_s);
+  const Eigen::Vector3d sg = s_g.cwiseMax(kGyroScatterFloor_radps);
   const double sg_rms = std::sqrt(sg.squaredNorm() / 3.0);
 
   for (int j = 0; j < count; ++j) {
@@ -679,7 +679,7 @@ ImuCalibrationResult RecursiveMultiPosition::Current() const {
 
 // ------------------------------------------------------------------------ records
 
-MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::string& base_dir) {
+MultiPositionData ReadMultiPositionData(const ConfigNode& node, const std::string& base_dir) {
   node.RequireKeys({"imu", "latitude_deg", "height_m", "trajectory", "settle_s", "accel_saturation_mps2",
                     "gyro_saturation_deg_s", "g_sensitivity"});
   if (!node.Has("imu")) node.Fail("imu", "missing: the IMU file of the multi-position record");
@@ -691,7 +691,7 @@ MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::
   if (!(std::abs(lat_deg) <= 90.0)) node.Fail("latitude_deg", "must be within [-90, 90]");
   data.latitude_rad = lat_deg * kDegToRad;
   data.height_m = node.Double("height_m", 0.0, -1e4, 1e5);
-  const sim::ConfigNode trajectory = node.Child("trajectory");
+  const ConfigNode trajectory = node.Child("trajectory");
   const sim::CalibrationRigConfig rig = sim::ParseCalibrationRigConfig(trajectory);
   if (rig.kind != sim::CalibrationRigConfig::Kind::kMultiPosition) {
     trajectory.Fail("kind", "must be multiposition for a multi-position calibration");
@@ -708,12 +708,12 @@ MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::
 }
 
 ImuCalibrationResult CalibrateMultiPositionRecord(const std::string& record_path) {
-  const sim::ConfigNode root = sim::LoadYamlFile(record_path);
+  const ConfigNode root = LoadYamlFile(record_path);
   const std::string base_dir = std::filesystem::path(record_path).parent_path().string();
   return CalibrateMultiPosition(ReadMultiPositionData(root, base_dir), ReadMultiPositionOptions(root));
 }
 
-MultiPositionOptions ReadMultiPositionOptions(const sim::ConfigNode& node) {
+MultiPositionOptions ReadMultiPositionOptions(const ConfigNode& node) {
   MultiPositionOptions options;
   options.settle_s = node.NonNegative("settle_s", options.settle_s);
   options.accel_saturation_mps2 = node.NonNegative("accel_saturation_mps2", 0.0);

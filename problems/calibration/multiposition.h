@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "core/sim/calibration_rig.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 #include "core/types.h"
 #include "problems/calibration/imu_calibration.h"
 
@@ -59,11 +59,11 @@ ImuCalibrationResult CalibrateMultiPosition(const MultiPositionData& data, const
 
 /// Reads {imu, latitude_deg, height_m, trajectory} from a record node (relative paths
 /// against base_dir). Throws InputError (file, line, key).
-MultiPositionData ReadMultiPositionData(const sim::ConfigNode& node, const std::string& base_dir);
+MultiPositionData ReadMultiPositionData(const ConfigNode& node, const std::string& base_dir);
 
 /// The record's optional keys: settle_s, accel_saturation_mps2, gyro_saturation_deg_s (0: no
 /// limit), g_sensitivity (bool). Throws InputError (file, line, key) for negative values.
-MultiPositionOptions ReadMultiPositionOptions(const sim::ConfigNode& node);
+MultiPositionOptions ReadMultiPositionOptions(const ConfigNode& node);
 
 /// The recursive form: feed positions in schedule order.
 class RecursiveMultiPosition {

@@ -27,7 +27,7 @@
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
 #include "core/sim/calibration_rig.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -241,7 +241,7 @@ constexpr int kGOffset = 2 * kTriadParameters;
 /// (the Coriolis force along the pivot, ~2e-4 m/s^2, is below it), 0.06 deg/s of rate (ten
 /// times the Earth rate: the Earth rate alone cannot separate a misalignment in minutes).
 constexpr double kMinSpecificForce_mps2 = 1e-2;
-constexpr double kMinRate_rad_s = 1e-3;
+constexpr double kMinRate_radps = 1e-3;
 /// Normalised normal matrices with an eigenvalue below this fraction of the largest are
 /// singular: the parameters in that direction are a combination of the others.
 constexpr double kCollinear = 1e-10;
@@ -374,7 +374,7 @@ std::vector<int> ObservableColumns(const AxisProblem& axis, const Normal& total,
     if (kind == Column::kForce && rms < kMinSpecificForce_mps2) {
       unobservable->push_back(name + ": not excited (no run puts specific force along the axis it multiplies; "
                                      "rms " + std::to_string(rms) + " m/s^2)");
-    } else if (kind == Column::kRate && rms < kMinRate_rad_s) {
+    } else if (kind == Column::kRate && rms < kMinRate_radps) {
       unobservable->push_back(name + ": not excited (no run turns about the axis it multiplies; rms " +
                               std::to_string(rms) + " rad/s, the Earth rate alone)");
     } else {
@@ -429,7 +429,7 @@ SwingFit Perturbed(const SwingFit& fit, const Eigen::Vector4d& d) {
   f.c1_per_s += d(0);
   f.c2_per_s2 += d(1);
   f.theta0_rad += d(2);
-  f.rate0_rad_s += d(3);
+  f.rate0_radps += d(3);
   return f;
 }
 
@@ -525,7 +525,7 @@ SwingFit FitSwing(const AngleRecord& angle) {
   fit.c1_per_s = p[0];
   fit.c2_per_s2 = p[1];
   fit.theta0_rad = p[2];
-  fit.rate0_rad_s = p[3];
+  fit.rate0_radps = p[3];
   fit.samples = n;
   double cost = 0.0;
   problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
@@ -549,7 +549,7 @@ std::vector<SwingPoint> EvaluateSwing(const SwingFit& fit, const std::vector<dou
   std::vector<SwingPoint> out;
   out.reserve(t_s.size());
   const double h_max = StepFor(fit.c2_per_s2);
-  double theta = fit.theta0_rad, rate = fit.rate0_rad_s, t = fit.t0_s;
+  double theta = fit.theta0_rad, rate = fit.rate0_radps, t = fit.t0_s;
   for (const double target : t_s) {
     const double dt = target - t;
     if (dt != 0.0) {
@@ -572,7 +572,7 @@ std::vector<ImuSample> TrueIncrements(const SwingFit& fit, const PendulumGeometr
   const Eigen::Vector3d w_ie = wgs84::EarthRateNed(g.latitude_rad);
   const double rm_h = wgs84::MeridianRadius(g.latitude_rad) + g.height_m;
   const Eigen::Matrix3d R_b_p = g.mounting_p_b.transpose();
-  Augmented y{fit.theta0_rad, fit.rate0_rad_s, 0.0, 0.0, 0.0};
+  Augmented y{fit.theta0_rad, fit.rate0_radps, 0.0, 0.0, 0.0};
   double t = fit.t0_s;
   const auto advance_to = [&](double target) {
     if (target != t) Advance(fit.c1_per_s, fit.c2_per_s2, target - t, h_max, &y);
@@ -728,7 +728,7 @@ ImuCalibrationResult CalibratePendulum(const PendulumData& data, const PendulumO
 // -------------------------------------------------------------------- record
 
 PendulumData ReadPendulumRecord(const std::string& record_path) {
-  const sim::ConfigNode root = sim::LoadYamlFile(record_path);
+  const ConfigNode root = LoadYamlFile(record_path);
   root.RequireKeys({"latitude_deg", "height_m", "runs"});
   PendulumData data;
   if (!root.Has("latitude_deg")) root.Fail("latitude_deg", "required (the Earth rate in the truth depends on it)");
@@ -740,7 +740,7 @@ PendulumData ReadPendulumRecord(const std::string& record_path) {
     const std::filesystem::path f(p);
     return (f.is_absolute() || base.empty() ? f : base / f).string();
   };
-  for (const sim::ConfigNode& node : root.Elements("runs")) {
+  for (const ConfigNode& node : root.Elements("runs")) {
     node.RequireKeys({"imu", "angle", "length_m", "mounting", "mounting_deg"});
     for (const char* key : {"imu", "angle", "length_m"}) {
       if (!node.Has(key)) node.Fail(key, "required");

@@ -59,7 +59,7 @@ struct SwingFit {
   double c1_per_s = 0.0;
   double c2_per_s2 = 0.0;
   double theta0_rad = 0.0;
-  double rate0_rad_s = 0.0;
+  double rate0_radps = 0.0;
   /// Covariance of (c1, c2, theta0, rate0), scaled by the residual variance.
   Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
   double residual_rms_rad = 0.0;  ///< the encoder noise as the fit sees it
@@ -75,7 +75,7 @@ SwingFit FitSwing(const AngleRecord& angle);
 /// The fitted solution (theta, theta', theta'') at times t >= t0 (RK4, the fit's steps).
 struct SwingPoint {
   double theta_rad = 0.0;
-  double rate_rad_s = 0.0;
+  double rate_radps = 0.0;
   double accel_rad_s2 = 0.0;
 };
 std::vector<SwingPoint> EvaluateSwing(const SwingFit& fit, const std::vector<double>& t_s);

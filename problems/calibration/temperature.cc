@@ -20,7 +20,7 @@
 #include "core/io/input_error.h"
 #include "core/io/text_reader.h"
 #include "core/sim/calibration_rig.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -731,7 +731,7 @@ TemperatureSeries ReadTemperatureFile(const std::string& path) {
 TemperatureRecord ReadTemperatureRecord(const std::string& record_path) {
   TemperatureRecord record;
   TemperatureCalibrationOptions* options = &record.options;
-  const sim::ConfigNode root = sim::LoadYamlFile(record_path);
+  const ConfigNode root = LoadYamlFile(record_path);
   root.RequireKeys({"order", "latitude_deg", "height_m", "reference_degC", "segment_s", "runs"});
   options->order = root.Int("order", 2, 1, kMaxOrder);
   if (!root.Has("latitude_deg")) root.Fail("latitude_deg", "missing (the latitude of the chamber, deg)");
@@ -743,11 +743,11 @@ TemperatureRecord ReadTemperatureRecord(const std::string& record_path) {
   }
   options->segment_s = root.Double("segment_s", options->segment_s, kMinSegmentS, kMaxSegmentS);
   if (!root.Has("runs")) root.Fail("runs", "missing (a list of {temperature_degC, imu, trajectory})");
-  const std::vector<sim::ConfigNode> run_nodes = root.Elements("runs");
+  const std::vector<ConfigNode> run_nodes = root.Elements("runs");
   if (run_nodes.empty()) root.Fail("runs", "the list is empty");
   const std::string base_dir = std::filesystem::path(record_path).parent_path().string();
 
-  for (const sim::ConfigNode& node : run_nodes) {
+  for (const ConfigNode& node : run_nodes) {
     node.RequireKeys({"temperature_degC", "temperature", "imu", "trajectory"});
     const bool warm_up = node.Has("temperature");
     if (warm_up && node.Has("temperature_degC")) {
@@ -777,13 +777,13 @@ TemperatureRecord ReadTemperatureRecord(const std::string& record_path) {
       std::filesystem::path p(file);
       if (p.is_relative() && !base_dir.empty()) p = std::filesystem::path(base_dir) / p;
       run.temperature = ReadTemperatureFile(p.string());
-      run.data = ReadMultiPositionData(sim::ConfigNode(merged, node.file(), node.path()), base_dir);
+      run.data = ReadMultiPositionData(ConfigNode(merged, node.file(), node.path()), base_dir);
       record.warm_up.push_back(std::move(run));
     } else {
       TemperatureRun run;
       run.temperature_degC =
           node.Double("temperature_degC", 0.0, kMinRecordTemperatureDegC, kMaxRecordTemperatureDegC);
-      run.data = ReadMultiPositionData(sim::ConfigNode(merged, node.file(), node.path()), base_dir);
+      run.data = ReadMultiPositionData(ConfigNode(merged, node.file(), node.path()), base_dir);
       record.chamber.push_back(std::move(run));
     }
   }

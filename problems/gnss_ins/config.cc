@@ -18,24 +18,16 @@
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
+#include "core/units.h"
 #include "problems/ins/pure_ins.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
-using sim::ConfigNode;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-/// Standard gravity, for the ug / mg / mGal units of accelerometer errors (1 ug = 1e-6 g0).
-constexpr double kG0_mps2 = 9.80665;
-constexpr double kUgToMps2 = 1e-6 * kG0_mps2;
-constexpr double kMgalToMps2 = 1e-5;  // 1 mGal = 1e-5 m/s^2
-constexpr double kDegHToRadps = kDegToRad / 3600.0;
-/// deg/sqrt(h) -> rad/sqrt(s): sqrt(h) = 60 sqrt(s).
-constexpr double kDegSqrtHToRadSqrtS = kDegToRad / 60.0;
-constexpr double kPpm = 1e-6;
 
 // ---------------------------------------------------------------------------------------
 // Small readers on top of ConfigNode that add the checks this configuration needs.
@@ -128,10 +120,10 @@ ImuNoise ParseImuNoise(const ConfigNode& n, bool scale_factors) {
                  "accel_bias_std_ug", "gyro_scale_std_ppm", "accel_scale_std_ppm",
                  "correlation_time_s"});
   ImuNoise x;
-  x.gyro_arw_rad_per_sqrt_s = RequiredSigma(n, "gyro_arw_deg_sqrt_h") * kDegSqrtHToRadSqrtS;
-  x.accel_vrw_mps_per_sqrt_s = RequiredSigma(n, "accel_vrw_m_s_sqrt_h") / 60.0;
-  x.gyro_bias_std_radps = RequiredSigma(n, "gyro_bias_std_deg_h") * kDegHToRadps;
-  x.accel_bias_std_mps2 = RequiredSigma(n, "accel_bias_std_ug") * kUgToMps2;
+  x.gyro_arw_rad_per_sqrt_s = RequiredSigma(n, "gyro_arw_deg_sqrt_h") * kDegPerSqrtHour_radpsqrts;
+  x.accel_vrw_mps_per_sqrt_s = RequiredSigma(n, "accel_vrw_m_s_sqrt_h") * kMpsPerSqrtHour_mpspsqrts;
+  x.gyro_bias_std_radps = RequiredSigma(n, "gyro_bias_std_deg_h") * kDegPerHour_radps;
+  x.accel_bias_std_mps2 = RequiredSigma(n, "accel_bias_std_ug") * kMicroG_mps2;
   if (scale_factors) {
     x.gyro_scale_std = RequiredSigma(n, "gyro_scale_std_ppm") * kPpm;
     x.accel_scale_std = RequiredSigma(n, "accel_scale_std_ppm") * kPpm;
@@ -208,16 +200,16 @@ InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double
     n.Fail(has_file ? "nav_file" : "position_deg_m",
            "an initial state is only read with source: given (this source aligns itself)");
   }
-  x.imu_errors.bg_radps = ScalarOrVector(n, "gyro_bias_deg_h", Eigen::Vector3d::Zero()) * kDegHToRadps;
-  x.imu_errors.ba_mps2 = ScalarOrVector(n, "accel_bias_ug", Eigen::Vector3d::Zero()) * kUgToMps2;
+  x.imu_errors.bg_radps = ScalarOrVector(n, "gyro_bias_deg_h", Eigen::Vector3d::Zero()) * kDegPerHour_radps;
+  x.imu_errors.ba_mps2 = ScalarOrVector(n, "accel_bias_ug", Eigen::Vector3d::Zero()) * kMicroG_mps2;
   x.imu_errors.sg = ScalarOrVector(n, "gyro_scale_ppm", Eigen::Vector3d::Zero()) * kPpm;
   x.imu_errors.sa = ScalarOrVector(n, "accel_scale_ppm", Eigen::Vector3d::Zero()) * kPpm;
   x.std.pos_ned_m = SigmaVector(n, "position_std_m", x.std.pos_ned_m);
   x.std.vel_ned_mps = SigmaVector(n, "velocity_std_mps", x.std.vel_ned_mps);
   x.std.att_rad = SigmaVector(n, "attitude_std_deg", x.std.att_rad / kDegToRad) * kDegToRad;
   // Absent: zero, which means "take the imu_noise value" (InitialStd).
-  x.std.bg_radps = SigmaVector(n, "gyro_bias_std_deg_h", Eigen::Vector3d::Zero()) * kDegHToRadps;
-  x.std.ba_mps2 = SigmaVector(n, "accel_bias_std_ug", Eigen::Vector3d::Zero()) * kUgToMps2;
+  x.std.bg_radps = SigmaVector(n, "gyro_bias_std_deg_h", Eigen::Vector3d::Zero()) * kDegPerHour_radps;
+  x.std.ba_mps2 = SigmaVector(n, "accel_bias_std_ug", Eigen::Vector3d::Zero()) * kMicroG_mps2;
   x.std.sg = SigmaVector(n, "gyro_scale_std_ppm", Eigen::Vector3d::Zero()) * kPpm;
   x.std.sa = SigmaVector(n, "accel_scale_std_ppm", Eigen::Vector3d::Zero()) * kPpm;
   x.static_duration_s = Sigma(n, "static_duration_s", x.static_duration_s);
@@ -308,9 +300,9 @@ MagConfig ParseMag(const ConfigNode& n) {
       !have_declination) {
     n.Fail("field", "heading modes need field.declination_deg (0 only if you mean it)");
   }
-  x.hard_iron_uT = n.Vector("hard_iron_uT", Eigen::Vector3d::Zero());
-  x.soft_iron = Matrix(n, "soft_iron", Eigen::Matrix3d::Zero());
-  if (std::abs((Eigen::Matrix3d::Identity() + x.soft_iron).determinant()) < 1e-6) {
+  x.iron.hard_iron_uT = n.Vector("hard_iron_uT", Eigen::Vector3d::Zero());
+  x.iron.soft_iron = Matrix(n, "soft_iron", Eigen::Matrix3d::Zero());
+  if (std::abs((Eigen::Matrix3d::Identity() + x.iron.soft_iron).determinant()) < 1e-6) {
     n.Fail("soft_iron", "I + soft_iron is singular");
   }
   x.noise_uT = Sigma(n, "noise_uT", x.noise_uT);
@@ -420,7 +412,7 @@ BatchConfig ParseBatch(const ConfigNode& n) {
   x.threads = n.Int("threads", x.threads, 1, 1024);
   x.covariance = n.Bool("covariance", x.covariance);
   x.relinearize_bias_radps =
-      NonNegative(n, "relinearize_bias_deg_h", x.relinearize_bias_radps / kDegHToRadps) * kDegHToRadps;
+      NonNegative(n, "relinearize_bias_deg_h", x.relinearize_bias_radps / kDegPerHour_radps) * kDegPerHour_radps;
   return x;
 }
 
@@ -513,11 +505,11 @@ ImuNoise ObginsNoise(const ConfigNode& root) {
     if (!m.Has(key)) m.Fail(key, "required (OB_GINS configuration)");
   }
   ImuNoise n;
-  n.gyro_arw_rad_per_sqrt_s = Sigma(m, "arw", 1.0) * kDegSqrtHToRadSqrtS;
-  n.accel_vrw_mps_per_sqrt_s = Sigma(m, "vrw", 1.0) / 60.0;
-  n.gyro_bias_std_radps = Sigma(m, "gbstd", 1.0) * kDegHToRadps;
-  n.accel_bias_std_mps2 = Sigma(m, "abstd", 1.0) * kMgalToMps2;
-  n.correlation_time_s = Sigma(m, "corrtime", 1.0) * 3600.0;
+  n.gyro_arw_rad_per_sqrt_s = Sigma(m, "arw", 1.0) * kDegPerSqrtHour_radpsqrts;
+  n.accel_vrw_mps_per_sqrt_s = Sigma(m, "vrw", 1.0) * kMpsPerSqrtHour_mpspsqrts;
+  n.gyro_bias_std_radps = Sigma(m, "gbstd", 1.0) * kDegPerHour_radps;
+  n.accel_bias_std_mps2 = Sigma(m, "abstd", 1.0) * kMilliGal_mps2;
+  n.correlation_time_s = Sigma(m, "corrtime", 1.0) * kHour_s;
   return n;
 }
 
@@ -532,8 +524,8 @@ void ObginsInit(const ConfigNode& root, GnssInsConfig* c) {
   s.nav.q_n_b = QuatFromEuler(att[0] * kDegToRad, att[1] * kDegToRad, att[2] * kDegToRad);
   c->init.source = InitConfig::Source::kGiven;
   c->init.position_from_gnss = true;
-  c->init.imu_errors.bg_radps = KfVector(root, "initgb", false) * kDegHToRadps;
-  c->init.imu_errors.ba_mps2 = KfVector(root, "initab", false) * kMgalToMps2;
+  c->init.imu_errors.bg_radps = KfVector(root, "initgb", false) * kDegPerHour_radps;
+  c->init.imu_errors.ba_mps2 = KfVector(root, "initab", false) * kMilliGal_mps2;
   s.imu = c->init.imu_errors;
   c->init.state = s;
   c->init.std.pos_ned_m = Eigen::Vector3d::Constant(1.0);
@@ -563,7 +555,7 @@ void ObginsVehicle(const ConfigNode& root, GnssInsConfig* c) {
 }  // namespace
 
 GnssInsConfig LoadGnssInsConfig(const std::string& path) {
-  const ConfigNode root = sim::LoadYamlFile(path);
+  const ConfigNode root = LoadYamlFile(path);
   root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "nhc", "odometer", "vehicle", "gnss",
                     "outages", "filter", "batch", "output_rate_hz", "start_s", "end_s"});
   if (!root.Has("imu_noise")) root.Fail("imu_noise", "required");
@@ -592,7 +584,7 @@ GnssInsConfig LoadGnssInsConfig(const std::string& path) {
 }
 
 GnssInsConfig LoadKfginsConfig(const std::string& path) {
-  const ConfigNode root = sim::LoadYamlFile(path);
+  const ConfigNode root = LoadYamlFile(path);
   const YAML::Node& y = root.yaml();
   if (!y.IsMap()) root.Fail("", "expected a mapping of keys to values (a KF-GINS configuration)");
   static const char* const kKnown[] = {
@@ -642,8 +634,8 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
   s.nav.v_n_mps = vel;
   s.nav.q_n_b = QuatFromEuler(att[0] * kDegToRad, att[1] * kDegToRad, att[2] * kDegToRad);
   c.init.source = InitConfig::Source::kGiven;
-  c.init.imu_errors.bg_radps = KfVector(root, "initgyrbias", true) * kDegHToRadps;
-  c.init.imu_errors.ba_mps2 = KfVector(root, "initaccbias", true) * kMgalToMps2;
+  c.init.imu_errors.bg_radps = KfVector(root, "initgyrbias", true) * kDegPerHour_radps;
+  c.init.imu_errors.ba_mps2 = KfVector(root, "initaccbias", true) * kMilliGal_mps2;
   c.init.imu_errors.sg = KfVector(root, "initgyrscale", true) * kPpm;
   c.init.imu_errors.sa = KfVector(root, "initaccscale", true) * kPpm;
   s.imu = c.init.imu_errors;
@@ -654,8 +646,8 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
   // equal to them to first order for a level attitude (docs/gnss-ins.md).
   c.init.std.att_rad = KfSigmaVector(root, "initattstd", true) * kDegToRad;
   // Optional: absent (zero) means "take the imunoise value", as in KF-GINS.
-  c.init.std.bg_radps = KfSigmaVector(root, "initbgstd", false) * kDegHToRadps;
-  c.init.std.ba_mps2 = KfSigmaVector(root, "initbastd", false) * kMgalToMps2;
+  c.init.std.bg_radps = KfSigmaVector(root, "initbgstd", false) * kDegPerHour_radps;
+  c.init.std.ba_mps2 = KfSigmaVector(root, "initbastd", false) * kMilliGal_mps2;
   c.init.std.sg = KfSigmaVector(root, "initsgstd", false) * kPpm;
   c.init.std.sa = KfSigmaVector(root, "initsastd", false) * kPpm;
 
@@ -663,12 +655,12 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
   if (!root.Has("imunoise")) root.Fail("imunoise", "required (KF-GINS configuration)");
   noise.RequireKeys({"arw", "vrw", "gbstd", "abstd", "gsstd", "asstd", "corrtime"});
   c.imu_noise.gyro_arw_rad_per_sqrt_s =
-      OneValue(noise, "arw", KfSigmaVector(noise, "arw", true)) * kDegSqrtHToRadSqrtS;
-  c.imu_noise.accel_vrw_mps_per_sqrt_s = OneValue(noise, "vrw", KfSigmaVector(noise, "vrw", true)) / 60.0;
+      OneValue(noise, "arw", KfSigmaVector(noise, "arw", true)) * kDegPerSqrtHour_radpsqrts;
+  c.imu_noise.accel_vrw_mps_per_sqrt_s = OneValue(noise, "vrw", KfSigmaVector(noise, "vrw", true)) * kMpsPerSqrtHour_mpspsqrts;
   c.imu_noise.gyro_bias_std_radps =
-      OneValue(noise, "gbstd", KfSigmaVector(noise, "gbstd", true)) * kDegHToRadps;
+      OneValue(noise, "gbstd", KfSigmaVector(noise, "gbstd", true)) * kDegPerHour_radps;
   c.imu_noise.accel_bias_std_mps2 =
-      OneValue(noise, "abstd", KfSigmaVector(noise, "abstd", true)) * kMgalToMps2;
+      OneValue(noise, "abstd", KfSigmaVector(noise, "abstd", true)) * kMilliGal_mps2;
   // Scale factors: KF-GINS always estimates them (21 states); a zero gsstd/asstd turns
   // them off here (15 states), since a zero standard deviation means "not estimated".
   const Eigen::Vector3d gs = KfSigmaVector(noise, "gsstd", true, /*zero_allowed=*/true);
@@ -685,7 +677,7 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
   if (!noise.Has("corrtime")) noise.Fail("corrtime", "required (KF-GINS configuration)");
   const double corr_h = noise.Double("corrtime", 0.0);
   if (!(corr_h > 0.0)) noise.Fail("corrtime", "must be > 0 (hours)");
-  c.imu_noise.correlation_time_s = corr_h * 3600.0;
+  c.imu_noise.correlation_time_s = corr_h * kHour_s;
   // Antenna lever arm: IMU frame = body frame (KF-GINS has no mounting rotation).
   c.installation.antenna_lever_arm_b_m = KfVector(root, "antlever", true);
 
@@ -698,7 +690,7 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
 }
 
 GnssInsConfig LoadObginsConfig(const std::string& path) {
-  const ConfigNode root = sim::LoadYamlFile(path);
+  const ConfigNode root = LoadYamlFile(path);
   const YAML::Node& y = root.yaml();
   if (!y.IsMap()) root.Fail("", "expected a mapping of keys to values (an OB_GINS configuration)");
   WarnUnused(path, y, {"imufile", "gnssfile", "outputpath", "starttime", "endtime", "initvel", "initatt", "initgb",

@@ -9,9 +9,11 @@
 
 #include <Eigen/Core>
 
+#include "core/mag_iron_model.h"
 #include "core/types.h"
 #include "problems/gnss_ins/ins_vocabulary.h"
 #include "problems/ins/sources/odometer.h"
+#include "core/units.h"
 
 namespace navtwin::gnss_ins {
 

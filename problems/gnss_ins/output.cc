@@ -5,14 +5,10 @@
 
 #include "core/io/text_line.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::gnss_ins {
 namespace {
-
-constexpr double kRadpsToDegH = kRadToDeg * 3600.0;
-/// m/s^2 -> mg (1 mg = 1e-3 standard gravity, 9.80665 m/s^2).
-constexpr double kMps2ToMg = 1.0 / (1e-3 * 9.80665);
-constexpr double kToPpm = 1e6;
 
 /// One CSV row, numbers in the shortest form that reads back exactly (TextLine: the
 /// files have a row per IMU epoch, so stream formatting would dominate the run).
@@ -61,9 +57,9 @@ void NavOutputWriter::Write(const NavEpoch& epoch) {
   for (int i = 0; i < n; ++i) {
     double scale = 1.0;
     if (i >= err::kAtt && i < err::kBg) scale = kRadToDeg;
-    if (i >= err::kBg && i < err::kBa) scale = kRadpsToDegH;
-    if (i >= err::kBa && i < err::kSg) scale = kMps2ToMg;
-    if (i >= err::kSg) scale = kToPpm;
+    if (i >= err::kBg && i < err::kBa) scale = 1.0 / kDegPerHour_radps;
+    if (i >= err::kBa && i < err::kSg) scale = 1.0 / kMilliG_mps2;
+    if (i >= err::kSg) scale = 1.0 / kPpm;
     sd[i] = i < epoch.std.size() ? epoch.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
   }
   Row(std_.stream(), s.t_s, sd, n);
@@ -71,10 +67,10 @@ void NavOutputWriter::Write(const NavEpoch& epoch) {
   const ImuErrors& e = epoch.state.imu;
   double imu[12];
   for (int i = 0; i < 3; ++i) {
-    imu[i] = e.bg_radps[i] * kRadpsToDegH;
-    imu[3 + i] = e.ba_mps2[i] * kMps2ToMg;
-    imu[6 + i] = e.sg[i] * kToPpm;
-    imu[9 + i] = e.sa[i] * kToPpm;
+    imu[i] = e.bg_radps[i] / kDegPerHour_radps;
+    imu[3 + i] = e.ba_mps2[i] / kMilliG_mps2;
+    imu[6 + i] = e.sg[i] / kPpm;
+    imu[9 + i] = e.sa[i] / kPpm;
   }
   Row(errors_.stream(), s.t_s, imu, scale_factors_ ? 12 : 6);
   ++count_;

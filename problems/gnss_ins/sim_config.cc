@@ -8,12 +8,11 @@
 #include <Eigen/Core>
 
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
-constexpr double kRadToDegS = 180.0 / 3.14159265358979323846;
-constexpr double kG0_mps2 = 9.80665;
 
 std::string Num(double x) {
   std::ostringstream s;
@@ -53,15 +52,15 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
                             "with a calibrated magnetometer would have them.\n"
                           : ".\n")
     << "imu_noise:\n"
-       "  gyro_arw_deg_sqrt_h: " << Num(gyro.white_noise * kRadToDegS * 60.0) << "\n"
-       "  accel_vrw_m_s_sqrt_h: " << Num(accel.white_noise * 60.0) << "\n"
-       "  gyro_bias_std_deg_h: " << Num(gyro.bias.sigma * kRadToDegS * 3600.0) << "\n"
-       "  accel_bias_std_ug: " << Num(accel.bias.sigma / (1e-6 * kG0_mps2)) << "\n"
-       "  gyro_scale_std_ppm: " << Num(gyro.scale_factor.sigma * 1e6) << "\n"
-       "  accel_scale_std_ppm: " << Num(accel.scale_factor.sigma * 1e6) << "\n"
+       "  gyro_arw_deg_sqrt_h: " << Num(gyro.white_noise / kDegPerSqrtHour_radpsqrts) << "\n"
+       "  accel_vrw_m_s_sqrt_h: " << Num(accel.white_noise / kMpsPerSqrtHour_mpspsqrts) << "\n"
+       "  gyro_bias_std_deg_h: " << Num(gyro.bias.sigma / kDegPerHour_radps) << "\n"
+       "  accel_bias_std_ug: " << Num(accel.bias.sigma / kMicroG_mps2) << "\n"
+       "  gyro_scale_std_ppm: " << Num(gyro.scale_factor.sigma / kPpm) << "\n"
+       "  accel_scale_std_ppm: " << Num(accel.scale_factor.sigma / kPpm) << "\n"
        "  correlation_time_s: inf   # constant turn-on biases and scale factors\n"
        "installation:\n"
-       "  imu_mounting_deg: " << Vec(scenario.imu.mounting_rpy_rad, kRadToDegS) << "\n"
+       "  imu_mounting_deg: " << Vec(scenario.imu.mounting_rpy_rad, kRadToDeg) << "\n"
        "  antenna_lever_arm_b_m: " << Vec(scenario.gnss->lever_arm_b_m) << "\n"
        "init:\n"
        "  source: given\n"
@@ -81,7 +80,7 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
     const Eigen::Vector3d field_ned_uT = VecFrom(mag["field_ned_uT"], "mag.field_ned_uT");
     // The heading modes' std: the same per-axis noise over the horizontal intensity
     // (docs/gnss-ins.md, "Magnetometer modes").
-    const double heading_std_deg = noise_uT / field_ned_uT.head<2>().norm() * kRadToDegS;
+    const double heading_std_deg = noise_uT / field_ned_uT.head<2>().norm() * kRadToDeg;
     y << "mag:\n"
          "  mode: " << mag_mode << "\n"
          "  field: {field_ned_uT: " << Vec(field_ned_uT) << "}\n"

@@ -2,7 +2,7 @@
 //
 // Unknowns (SI, north/east): dH, eps_NE, df_NE, dw_NE, dp0_NE, dv0_NE and the level steps
 // d_eps_NE,k (below), all started at zero.
-// Residuals: DistanceHeadingTiltWalkResidual per fix (factors/distance_heading_residual.h;
+// Residuals: DistanceHeadingTiltWalkResidual per fix (problems/inflight_alignment/distance_heading_residual.h;
 // DistanceHeadingResidual plus the steps before the fix) under the configured robust loss,
 // and zero-mean VectorPrior2 priors:
 //   level       sigma = initial.level_arcmin                         (both axes)
@@ -66,16 +66,13 @@
 #include <ceres/solver.h>
 
 #include "core/earth.h"
-#include "factors/distance_heading_residual.h"
+#include "core/units.h"
+#include "problems/inflight_alignment/distance_heading_residual.h"
 #include "solvers/batch_driver.h"
 
 namespace navtwin::inflight {
 namespace {
 
-constexpr double kArcmin_rad = M_PI / (180.0 * 60.0);
-constexpr double kDegPerHour_radps = M_PI / (180.0 * 3600.0);
-constexpr double kDegPerSqrtHour_radPerSqrtS = M_PI / (180.0 * 60.0);  // sqrt(1 h) = 60 sqrt(1 s)
-constexpr double kMicroG_mps2 = 1e-6 * 9.80665;  // standard gravity, the g of ug
 constexpr int kMinEpochs = 10;
 constexpr double kMinGainedDisplacement_m = 100.0;
 constexpr int kMaxTiltSteps = 1000;  // level random-walk steps (batch.tilt_segment_s)
@@ -122,10 +119,11 @@ void Require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("SolveHeadingBatch: " + what);
 }
 
-/// A prior sigma from the configuration: finite and >= 0 (0 holds the coordinate).
-double PriorSigma(double value, double unit, const std::string& field) {
-  Require(std::isfinite(value) && value >= 0.0, "config " + field + " must be finite and >= 0");
-  return value * unit;
+/// A prior sigma from the configuration (SI): finite and >= 0 (0 holds the coordinate).
+/// `key` is the configuration key the value came from.
+double PriorSigma(double value, const std::string& key) {
+  Require(std::isfinite(value) && value >= 0.0, "config " + key + " must be finite and >= 0");
+  return value;
 }
 
 void CheckEpochs(const std::vector<FreeInsEpoch>& epochs) {
@@ -166,12 +164,12 @@ double RobustWeight(RobustLoss loss, double scale_sigma, double squared_residual
 }
 
 BatchHeadingSolution SolveHeadingBatch(const std::vector<FreeInsEpoch>& epochs, double gps_sigma_m,
-                                       double lat_rad, double schuler_rate_rad_s, const InflightConfig& config) {
+                                       double lat_rad, double schuler_rate_radps, const InflightConfig& config) {
   CheckEpochs(epochs);
   Require(std::isfinite(gps_sigma_m) && gps_sigma_m > 0.0, "gps_sigma_m must be positive and finite");
   Require(std::isfinite(lat_rad) && std::abs(lat_rad) <= 0.5 * M_PI, "lat_rad must be finite, |lat| <= pi/2");
-  Require(std::isfinite(schuler_rate_rad_s) && schuler_rate_rad_s > 0.0,
-          "schuler_rate_rad_s must be positive and finite");
+  Require(std::isfinite(schuler_rate_radps) && schuler_rate_radps > 0.0,
+          "schuler_rate_radps must be positive and finite");
   const BatchOptions& batch = config.batch;
   Require(batch.max_iterations >= 1, "config batch.max_iterations must be >= 1");
   Require(batch.loss == RobustLoss::kNone || (std::isfinite(batch.loss_scale_sigma) && batch.loss_scale_sigma > 0.0),
@@ -180,15 +178,14 @@ BatchHeadingSolution SolveHeadingBatch(const std::vector<FreeInsEpoch>& epochs, 
           "config batch.tilt_segment_s must be finite and >= 0");
 
   // Prior sigmas (the comment at the top).
-  const double level_sigma = PriorSigma(config.initial.level_arcmin, kArcmin_rad, "initial.level_arcmin");
-  const double accel_sigma = PriorSigma(config.sensors.accel_bias_ug, kMicroG_mps2, "sensors.accel_bias_ug");
-  const double gyro_sigma = PriorSigma(config.sensors.gyro_bias_deg_h, kDegPerHour_radps, "sensors.gyro_bias_deg_h");
-  const double heading_sigma = PriorSigma(config.initial.heading_arcmin, kArcmin_rad, "initial.heading_arcmin");
-  const double position_sigma = PriorSigma(config.initial.position_m, 1.0, "initial.position_m");
-  const double velocity_sigma = PriorSigma(config.initial.velocity_mps, 1.0, "initial.velocity_mps");
-  const double arw_rad_sqrt_s =
-      PriorSigma(config.sensors.gyro_arw_deg_sqrt_h, kDegPerSqrtHour_radPerSqrtS, "sensors.gyro_arw_deg_sqrt_h");
-  const double earth_rate_coupling = wgs84::kOmegaIe_rad_s * std::cos(lat_rad) * heading_sigma;
+  const double level_sigma = PriorSigma(config.initial.level_rad, "initial.level_arcmin");
+  const double accel_sigma = PriorSigma(config.sensors.accel_bias_mps2, "sensors.accel_bias_ug");
+  const double gyro_sigma = PriorSigma(config.sensors.gyro_bias_radps, "sensors.gyro_bias_deg_h");
+  const double heading_sigma = PriorSigma(config.initial.heading_rad, "initial.heading_arcmin");
+  const double position_sigma = PriorSigma(config.initial.position_m, "initial.position_m");
+  const double velocity_sigma = PriorSigma(config.initial.velocity_mps, "initial.velocity_mps");
+  const double arw_rad_sqrt_s = PriorSigma(config.sensors.gyro_arw_rad_per_sqrt_s, "sensors.gyro_arw_deg_sqrt_h");
+  const double earth_rate_coupling = wgs84::kOmegaIe_radps * std::cos(lat_rad) * heading_sigma;
   const Eigen::Vector2d sigma_level(level_sigma, level_sigma);
   const Eigen::Vector2d sigma_accel(accel_sigma, accel_sigma);
   const Eigen::Vector2d sigma_gyro(gyro_sigma, std::hypot(gyro_sigma, earth_rate_coupling));
@@ -252,11 +249,11 @@ BatchHeadingSolution SolveHeadingBatch(const std::vector<FreeInsEpoch>& epochs, 
   fix_costs.reserve(epochs.size());
   for (const FreeInsEpoch& e : epochs) {
     const DistanceErrorSample& s = e.sample;
-    const std::array<double, kSchulerTerms> b = SchulerBasis(s.t_s, schuler_rate_rad_s);
+    const std::array<double, kSchulerTerms> b = SchulerBasis(s.t_s, schuler_rate_radps);
     std::vector<double*> parameters = {heading, level, accel, gyro, position0, velocity0};
     std::vector<double> step_basis_s2;
     for (std::size_t k = 0; k < step_time_s.size() && step_time_s[k] < s.t_s; ++k) {
-      step_basis_s2.push_back(SchulerBasis(s.t_s - step_time_s[k], schuler_rate_rad_s)[2]);
+      step_basis_s2.push_back(SchulerBasis(s.t_s - step_time_s[k], schuler_rate_radps)[2]);
       parameters.push_back(steps[k].data());
     }
     ceres::CostFunction* cost = DistanceHeadingTiltWalkResidual::Create(

@@ -5,7 +5,7 @@
 // heading residual at every raw GPS fix under a robust loss plus the sensor-specification
 // priors.
 //
-// Residual of one fix (factors/distance_heading_residual.h), whitened by the GPS sigma:
+// Residual of one fix (problems/inflight_alignment/distance_heading_residual.h), whitened by the GPS sigma:
 //     r = ( err - (Rz(dH) - I) D - s(t) - w(t) ) / sigma_gps,       2 x 1 (north, east)
 // with D the gained displacement and err the distance error of the fix (free_ins.h),
 // Rz(dH) the rotation of (N, E) by dH clockwise seen from above (the exact form of
@@ -65,13 +65,13 @@ struct BatchHeadingSolution {
 
 /// Solves the problem over epochs (from RunFreeIns; at least 10, with a gained
 /// displacement above 100 m somewhere). gps_sigma_m > 0 whitens the residuals; pass
-/// EstimateGpsSigma of the raw fixes otherwise. schuler_rate_rad_s from SchulerRate at
+/// EstimateGpsSigma of the raw fixes otherwise. schuler_rate_radps from SchulerRate at
 /// the start; lat_rad for the Earth-rate term of the gyro prior. Throws
 /// std::invalid_argument for too few epochs, non-finite input or a configuration value out
 /// of range (naming the key; also segments giving more than 1000 steps), std::runtime_error
 /// if Ceres fails or the covariance is rank-deficient (message says which block).
 BatchHeadingSolution SolveHeadingBatch(const std::vector<FreeInsEpoch>& epochs, double gps_sigma_m,
-                                       double lat_rad, double schuler_rate_rad_s,
+                                       double lat_rad, double schuler_rate_radps,
                                        const InflightConfig& config);
 
 /// The robust weight rho'(s) of the loss at a squared whitened residual s (1 for none).

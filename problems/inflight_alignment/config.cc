@@ -1,6 +1,6 @@
 // Reading the in-flight alignment configuration (config.h). Every key is optional and
 // keeps the default of config.h when absent; keys carry their units in their names, as in
-// the simulator's scenarios (core/sim/yaml_config.h). Unknown keys, wrong types and values
+// the simulator's scenarios (core/config/yaml_config.h). Unknown keys, wrong types and values
 // out of range are InputError naming the file, the line and the key path.
 #include "problems/inflight_alignment/config.h"
 
@@ -8,12 +8,11 @@
 #include <string>
 
 #include "core/io/input_error.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 namespace navtwin::inflight {
 namespace {
 
-using sim::ConfigNode;
 
 InflightSensorSpec ParseSensors(const ConfigNode& n) {
   n.RequireKeys({"gyro_bias_deg_h", "gyro_arw_deg_sqrt_h", "accel_bias_ug", "accel_vrw_m_s_sqrt_h",
@@ -21,10 +20,12 @@ InflightSensorSpec ParseSensors(const ConfigNode& n) {
   InflightSensorSpec s;
   // Biases and noise densities may be zero (a sensor without that error); the filter's
   // process noise and the Schuler priors then leave the term out.
-  s.gyro_bias_deg_h = n.NonNegative("gyro_bias_deg_h", s.gyro_bias_deg_h);
-  s.gyro_arw_deg_sqrt_h = n.NonNegative("gyro_arw_deg_sqrt_h", s.gyro_arw_deg_sqrt_h);
-  s.accel_bias_ug = n.NonNegative("accel_bias_ug", s.accel_bias_ug);
-  s.accel_vrw_m_s_sqrt_h = n.NonNegative("accel_vrw_m_s_sqrt_h", s.accel_vrw_m_s_sqrt_h);
+  s.gyro_bias_radps = n.NonNegativeSi("gyro_bias_deg_h", kDegPerHour_radps, s.gyro_bias_radps);
+  s.gyro_arw_rad_per_sqrt_s =
+      n.NonNegativeSi("gyro_arw_deg_sqrt_h", kDegPerSqrtHour_radpsqrts, s.gyro_arw_rad_per_sqrt_s);
+  s.accel_bias_mps2 = n.NonNegativeSi("accel_bias_ug", kMicroG_mps2, s.accel_bias_mps2);
+  s.accel_vrw_mps_per_sqrt_s =
+      n.NonNegativeSi("accel_vrw_m_s_sqrt_h", kMpsPerSqrtHour_mpspsqrts, s.accel_vrw_mps_per_sqrt_s);
   // 0 asks for the estimate from the data (EstimateGpsSigma).
   s.gps_sigma_m = n.NonNegative("gps_sigma_m", s.gps_sigma_m);
   return s;
@@ -36,8 +37,8 @@ InflightInitialSigma ParseInitial(const ConfigNode& n) {
   // The filter's initial covariance: every diagonal entry must be positive.
   s.position_m = n.Positive("position_m", s.position_m);
   s.velocity_mps = n.Positive("velocity_mps", s.velocity_mps);
-  s.level_arcmin = n.Positive("level_arcmin", s.level_arcmin);
-  s.heading_arcmin = n.Positive("heading_arcmin", s.heading_arcmin);
+  s.level_rad = n.PositiveSi("level_arcmin", kArcmin_rad, s.level_rad);
+  s.heading_rad = n.PositiveSi("heading_arcmin", kArcmin_rad, s.heading_rad);
   return s;
 }
 
@@ -99,8 +100,9 @@ GpsSmootherOptions ParseSmoother(const ConfigNode& n) {
 DistanceMethodOptions ParseDistance(const ConfigNode& n) {
   n.RequireKeys({"threshold_km", "recompute_every_km"});
   DistanceMethodOptions d;
-  d.threshold_km = n.Positive("threshold_km", d.threshold_km);
-  d.recompute_every_km = n.NonNegative("recompute_every_km", d.recompute_every_km);  // 0: once
+  constexpr double kKm_m = 1e3;
+  d.threshold_m = n.PositiveSi("threshold_km", kKm_m, d.threshold_m);
+  d.recompute_every_m = n.NonNegativeSi("recompute_every_km", kKm_m, d.recompute_every_m);  // 0: once
   return d;
 }
 
@@ -139,10 +141,10 @@ InflightConfig ParseRoot(const ConfigNode& root) {
 
 }  // namespace
 
-InflightConfig LoadInflightConfig(const std::string& path) { return ParseRoot(sim::LoadYamlFile(path)); }
+InflightConfig LoadInflightConfig(const std::string& path) { return ParseRoot(LoadYamlFile(path)); }
 
 InflightConfig ParseInflightConfig(const std::string& yaml_text, const std::string& file) {
-  return ParseRoot(sim::ParseYaml(yaml_text, file));
+  return ParseRoot(ParseYaml(yaml_text, file));
 }
 
 const char* RobustLossName(RobustLoss loss) {

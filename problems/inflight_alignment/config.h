@@ -1,22 +1,25 @@
 // Configuration of the in-flight heading alignment (seed 003, issue 7): the sensor
 // specification that sets the filter's process noise and the priors of the Schuler
 // terms, the GPS smoother, the distance-method policy and the batch's robust loss.
-// YAML keys (docs/inflight-alignment.md, "Configuration") carry their units; unknown keys
+// YAML keys (docs/inflight-alignment.md, "Configuration") carry their people units (deg/h,
+// ug, arcmin, km), converted to the SI members below as the file is read; unknown keys
 // are errors naming the file, line and key path. Defaults are the seed's 1 NM/h INS.
 #pragma once
 
 #include <string>
 
+#include "core/units.h"
 #include "problems/inflight_alignment/gps_smoother.h"
 
 namespace navtwin::inflight {
 
 /// Sensor specification (1 sigma), IMU axes = body FRD.
 struct InflightSensorSpec {
-  double gyro_bias_deg_h = 0.01;
-  double gyro_arw_deg_sqrt_h = 0.005;
-  double accel_bias_ug = 100.0;
-  double accel_vrw_m_s_sqrt_h = 0.0;  ///< velocity random walk (nav grade: negligible)
+  double gyro_bias_radps = 0.01 * kDegPerHour_radps;                   ///< key gyro_bias_deg_h
+  double gyro_arw_rad_per_sqrt_s = 0.005 * kDegPerSqrtHour_radpsqrts;  ///< key gyro_arw_deg_sqrt_h
+  double accel_bias_mps2 = 100.0 * kMicroG_mps2;                       ///< key accel_bias_ug
+  /// Velocity random walk (nav grade: negligible); key accel_vrw_m_s_sqrt_h.
+  double accel_vrw_mps_per_sqrt_s = 0.0;
   /// Position sigma of the raw GPS fixes per horizontal axis (m); 0: estimated from the
   /// data (third differences, a robust median form; see EstimateGpsSigma).
   double gps_sigma_m = 0.0;
@@ -31,8 +34,10 @@ struct InflightInitialSigma {
   /// 0.1 m/s is 1.4 arcmin. The default assumes the INS velocity was set from a reference
   /// (launcher at rest, master INS) to about 1 cm/s.
   double velocity_mps = 0.01;
-  double level_arcmin = 0.34;       ///< roll and pitch (aligned on the accelerometers: bias / g)
-  double heading_arcmin = 30.0;     ///< the error in-flight alignment is there to remove
+  /// Roll and pitch (aligned on the accelerometers: bias / g); key level_arcmin.
+  double level_rad = 0.34 * kArcmin_rad;
+  /// The error in-flight alignment is there to remove; key heading_arcmin.
+  double heading_rad = 30.0 * kArcmin_rad;
 };
 
 /// Barometric vertical channel: a second-order loop pulls the INS height to the
@@ -43,10 +48,10 @@ struct BaroLoopOptions {
 
 /// The distance method (seed 003, figure 2) and its re-computation policy.
 struct DistanceMethodOptions {
-  double threshold_km = 10.0;  ///< first heading computation after this distance flown
+  double threshold_m = 10e3;  ///< first heading computation after this distance flown (key threshold_km)
   /// After the first, recompute with every sample since the start each time the distance
-  /// flown has grown by this much (0: compute once, as the seed does).
-  double recompute_every_km = 10.0;
+  /// flown has grown by this much (0: compute once, as the seed does); key recompute_every_km.
+  double recompute_every_m = 10e3;
 };
 
 enum class RobustLoss { kNone, kHuber, kCauchy };

@@ -119,8 +119,8 @@ double SchulerRate(double lat_rad, double h_m) {
   return std::sqrt(wgs84::NormalGravity(lat_rad, h_m) / r_m);
 }
 
-std::array<double, kSchulerTerms> SchulerBasis(double t_s, double schuler_rate_rad_s) {
-  const double w = schuler_rate_rad_s;
+std::array<double, kSchulerTerms> SchulerBasis(double t_s, double schuler_rate_radps) {
+  const double w = schuler_rate_radps;
   const double x = w * t_s;
   const double half_sin = std::sin(0.5 * x);
   // x - sin x loses all its digits to cancellation for small x: series below x = 0.1
@@ -170,7 +170,7 @@ Design BuildDesign(const std::vector<DistanceErrorSample>& samples,
     d.a(re, 0) = s.dn_m;
     d.b(rn) = s.err_n_m;
     d.b(re) = s.err_e_m;
-    const std::array<double, kSchulerTerms> basis = SchulerBasis(s.t_s, options.schuler_rate_rad_s);
+    const std::array<double, kSchulerTerms> basis = SchulerBasis(s.t_s, options.schuler_rate_radps);
     int c = 1;
     for (int k = 0; k < kSchulerTerms; ++k) {
       if (!terms[k]) continue;
@@ -206,7 +206,7 @@ void CheckSamples(const std::vector<DistanceErrorSample>& samples, const Separat
       throw std::invalid_argument("SeparateHeadingError: a sample is not finite");
     }
   }
-  if (!(options.schuler_rate_rad_s > 0.0) || !std::isfinite(options.schuler_rate_rad_s)) {
+  if (!(options.schuler_rate_radps > 0.0) || !std::isfinite(options.schuler_rate_radps)) {
     throw std::invalid_argument("SeparateHeadingError: the Schuler rate must be positive");
   }
   std::array<double, 2 * kSchulerTerms> priors{};

@@ -133,7 +133,7 @@ double SchulerRate(double lat_rad, double h_m);
 
 /// The four basis functions of the comment above at time t since alignment started (m
 /// per unit coefficient), evaluated without cancellation for small w t.
-std::array<double, kSchulerTerms> SchulerBasis(double t_s, double schuler_rate_rad_s);
+std::array<double, kSchulerTerms> SchulerBasis(double t_s, double schuler_rate_radps);
 
 /// One epoch: time since alignment started, distance flown, distance error (INS minus
 /// reference), in metres.
@@ -146,7 +146,7 @@ struct DistanceErrorSample {
 };
 
 struct SeparationOptions {
-  double schuler_rate_rad_s = 1.2407e-3;  ///< sqrt(9.80665 / 6371000); see SchulerRate
+  double schuler_rate_radps = 1.2407e-3;  ///< sqrt(9.80665 / 6371000); see SchulerRate
   /// Terms fitted on both axes, index SchulerTerm. The velocity term is off by default:
   /// on a straight flight at constant speed dH dN(t) is linear in t, and so is an initial
   /// velocity error with the gyro term that holds it constant, so the two cannot be told

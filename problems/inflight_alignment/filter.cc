@@ -14,6 +14,7 @@
 #include "core/earth.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
+#include "core/units.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/ins/ins_state.h"
 #include "problems/inflight_alignment/gps_smoother.h"
@@ -26,10 +27,6 @@ using Vector11 = Eigen::Matrix<double, kFilterStates, 1>;
 using Matrix11 = Eigen::Matrix<double, kFilterStates, kFilterStates>;
 using Gain = Eigen::Matrix<double, kFilterStates, 2>;
 
-constexpr double kG0 = 9.80665;             // m/s^2 per g (specification units)
-constexpr double kArcmin = kDegToRad / 60.0;
-constexpr double kDegPerHour = kDegToRad / 3600.0;
-constexpr double kPerSqrtHour = 1.0 / 60.0;  // 1/sqrt(h) = 1/(60 sqrt(s))
 // Covariance propagation step: mean f_b and omega over ~0.1 s blocks. The fastest error
 // dynamics are the Schuler (84 min) and Earth-rate couplings, and during the pull-up the
 // specific force changes over seconds, so 0.1 s keeps the second-order transition
@@ -69,17 +66,17 @@ void Require(bool ok, const std::string& what) {
 void CheckConfig(const InflightConfig& c) {
   auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
-  Require(non_negative(c.sensors.gyro_bias_deg_h), "sensors.gyro_bias_deg_h must be >= 0");
-  Require(non_negative(c.sensors.gyro_arw_deg_sqrt_h), "sensors.gyro_arw_deg_sqrt_h must be >= 0");
-  Require(non_negative(c.sensors.accel_bias_ug), "sensors.accel_bias_ug must be >= 0");
-  Require(non_negative(c.sensors.accel_vrw_m_s_sqrt_h), "sensors.accel_vrw_m_s_sqrt_h must be >= 0");
+  Require(non_negative(c.sensors.gyro_bias_radps), "sensors.gyro_bias_deg_h must be >= 0");
+  Require(non_negative(c.sensors.gyro_arw_rad_per_sqrt_s), "sensors.gyro_arw_deg_sqrt_h must be >= 0");
+  Require(non_negative(c.sensors.accel_bias_mps2), "sensors.accel_bias_ug must be >= 0");
+  Require(non_negative(c.sensors.accel_vrw_mps_per_sqrt_s), "sensors.accel_vrw_m_s_sqrt_h must be >= 0");
   Require(positive(c.initial.position_m), "initial.position_m must be > 0");
   Require(positive(c.initial.velocity_mps) || c.initial.velocity_mps == 0.0, "initial.velocity_mps must be >= 0");
-  Require(positive(c.initial.level_arcmin), "initial.level_arcmin must be > 0");
-  Require(positive(c.initial.heading_arcmin), "initial.heading_arcmin must be > 0");
+  Require(positive(c.initial.level_rad), "initial.level_arcmin must be > 0");
+  Require(positive(c.initial.heading_rad), "initial.heading_arcmin must be > 0");
   Require(positive(c.baro.time_constant_s), "baro.time_constant_s must be > 0");
-  Require(positive(c.distance.threshold_km), "distance.threshold_km must be > 0");
-  Require(non_negative(c.distance.recompute_every_km), "distance.recompute_every_km must be >= 0");
+  Require(positive(c.distance.threshold_m), "distance.threshold_km must be > 0");
+  Require(non_negative(c.distance.recompute_every_m), "distance.recompute_every_km must be >= 0");
 }
 
 // The separation options of the distance method (filter.h, docs): Schuler rate at the
@@ -88,23 +85,23 @@ void CheckConfig(const InflightConfig& c) {
 SeparationOptions DistanceSeparationOptions(const InflightConfig& c, const NavState& initial,
                                             double position_sigma_m) {
   SeparationOptions o;
-  o.schuler_rate_rad_s = SchulerRate(initial.lat_rad, initial.h_m);
+  o.schuler_rate_radps = SchulerRate(initial.lat_rad, initial.h_m);
   o.position_sigma_m = position_sigma_m;
   o.terms = {{true, c.initial.velocity_mps > 0.0, true, true}};
-  const double ba_mps2 = c.sensors.accel_bias_ug * 1e-6 * kG0;
-  const double bg_radps = c.sensors.gyro_bias_deg_h * kDegPerHour;
-  const double level_rad = c.initial.level_arcmin * kArcmin;
+  const double ba_mps2 = c.sensors.accel_bias_mps2;
+  const double bg_radps = c.sensors.gyro_bias_radps;
+  const double level_rad = c.initial.level_rad;
   // The Earth-rate coupling of the initial heading error, Omega_ie cos L sigma_psi0, acts
   // like an east gyro bias (d phi_E / dt = Omega cos L phi_D), which drives the NORTH
   // position error: the north gyro term's prior is widened by it, the east one is not
   // (docs/inflight-alignment.md).
   const double earth_rate_heading_radps =
-      wgs84::kOmegaIe_rad_s * std::cos(initial.lat_rad) * c.initial.heading_arcmin * kArcmin;
+      wgs84::kOmegaIe_radps * std::cos(initial.lat_rad) * c.initial.heading_rad;
   o.prior_sigma[static_cast<int>(SchulerTerm::kOffset)] = c.initial.position_m;
   o.prior_sigma[static_cast<int>(SchulerTerm::kVelocity)] = c.initial.velocity_mps;
-  o.prior_sigma[static_cast<int>(SchulerTerm::kTilt)] = std::hypot(ba_mps2, kG0 * level_rad);
-  o.prior_sigma[static_cast<int>(SchulerTerm::kGyro)] = kG0 * bg_radps;
-  o.prior_sigma_north[static_cast<int>(SchulerTerm::kGyro)] = kG0 * std::hypot(bg_radps, earth_rate_heading_radps);
+  o.prior_sigma[static_cast<int>(SchulerTerm::kTilt)] = std::hypot(ba_mps2, kStandardGravity_mps2 * level_rad);
+  o.prior_sigma[static_cast<int>(SchulerTerm::kGyro)] = kStandardGravity_mps2 * bg_radps;
+  o.prior_sigma_north[static_cast<int>(SchulerTerm::kGyro)] = kStandardGravity_mps2 * std::hypot(bg_radps, earth_rate_heading_radps);
   return o;
 }
 
@@ -147,18 +144,18 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
   // uncertainty is the specification in the initial P (no driving noise, infinite
   // correlation time).
   ins::ImuNoise noise;
-  noise.gyro_arw_rad_per_sqrt_s = config.sensors.gyro_arw_deg_sqrt_h * kDegToRad * kPerSqrtHour;
-  noise.accel_vrw_mps_per_sqrt_s = config.sensors.accel_vrw_m_s_sqrt_h * kPerSqrtHour;
+  noise.gyro_arw_rad_per_sqrt_s = config.sensors.gyro_arw_rad_per_sqrt_s;
+  noise.accel_vrw_mps_per_sqrt_s = config.sensors.accel_vrw_mps_per_sqrt_s;
   noise.gyro_bias_std_radps = 0.0;
   noise.accel_bias_std_mps2 = 0.0;
   noise.correlation_time_s = std::numeric_limits<double>::infinity();
 
   // ---- initial covariance (config.initial and the bias specification)
   Matrix11 P = Matrix11::Zero();
-  const double level_rad = config.initial.level_arcmin * kArcmin;
-  const double heading_rad = config.initial.heading_arcmin * kArcmin;
-  const double bg_radps = config.sensors.gyro_bias_deg_h * kDegPerHour;
-  const double ba_mps2 = config.sensors.accel_bias_ug * 1e-6 * kG0;
+  const double level_rad = config.initial.level_rad;
+  const double heading_rad = config.initial.heading_rad;
+  const double bg_radps = config.sensors.gyro_bias_radps;
+  const double ba_mps2 = config.sensors.accel_bias_mps2;
   for (int k = 0; k < 2; ++k) {
     P(fstate::kPos + k, fstate::kPos + k) = config.initial.position_m * config.initial.position_m;
     P(fstate::kVel + k, fstate::kVel + k) = config.initial.velocity_mps * config.initial.velocity_mps;
@@ -183,7 +180,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
   std::optional<FreeInsTrack> free_ins;
   if (distance) free_ins.emplace(initial, config.baro);
   std::vector<DistanceErrorSample> samples;
-  double next_computation_m = config.distance.threshold_km * 1e3;
+  double next_computation_m = config.distance.threshold_m;
   double heading_applied_rad = 0.0;  // sum of the corrections fed back so far
 
   // ---- covariance propagation over blocks of ~kBlock_s
@@ -353,7 +350,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
           } catch (const std::invalid_argument&) {
             // not computable yet (see above)
           }
-          const double every_m = config.distance.recompute_every_km * 1e3;
+          const double every_m = config.distance.recompute_every_m;
           if (!computed) {
             // keep next_computation_m: retry at the next fix
           } else if (every_m > 0.0) {

@@ -9,6 +9,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "core/rotation.h"
 #include "solvers/eskf.h"
 
 namespace navtwin::inflight {
@@ -212,7 +213,7 @@ void GpsSmoother::Validate(const GnssSample& fix) const {
 }
 
 Eigen::Vector3d GpsSmoother::ToLocal(const GnssSample& fix) const {
-  const double dlon = std::remainder(fix.lon_rad - origin_.lon_rad, 2.0 * M_PI);
+  const double dlon = WrapPi(fix.lon_rad - origin_.lon_rad);
   return Eigen::Vector3d((fix.lat_rad - origin_.lat_rad) * rad_to_north_m_, dlon * rad_to_east_m_,
                          origin_.h_m - fix.h_m);
 }
@@ -220,7 +221,7 @@ Eigen::Vector3d GpsSmoother::ToLocal(const GnssSample& fix) const {
 wgs84::Geodetic GpsSmoother::ToGeodetic(const Eigen::Vector3d& pos_ned_m) const {
   wgs84::Geodetic g;
   g.lat_rad = origin_.lat_rad + pos_ned_m.x() / rad_to_north_m_;
-  g.lon_rad = std::remainder(origin_.lon_rad + pos_ned_m.y() / rad_to_east_m_, 2.0 * M_PI);
+  g.lon_rad = WrapPi(origin_.lon_rad + pos_ned_m.y() / rad_to_east_m_);
   g.h_m = origin_.h_m - pos_ned_m.z();
   return g;
 }

@@ -21,13 +21,13 @@
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "problems/inflight_alignment/distance_heading.h"
 
 namespace navtwin::inflight {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kRadToArcmin = kRadToDeg * 60.0;
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -103,14 +103,14 @@ MethodResult RunBatchMethod(const InflightInputs& inputs, const InflightConfig& 
   MethodResult r;
   r.method = Method::kBatch;
   const double lat_rad = inputs.initial.lat_rad;
-  const double schuler_rate_rad_s = SchulerRate(inputs.initial.lat_rad, inputs.initial.h_m);
+  const double schuler_rate_radps = SchulerRate(inputs.initial.lat_rad, inputs.initial.h_m);
 
   // run_time_s: the free INS and the whole-flight solve, what the method costs; the
   // prefix solves below only make the figures at each distance.
   const auto start = std::chrono::steady_clock::now();
   const std::vector<FreeInsEpoch> epochs = RunFreeIns(inputs, config);
   const double gps_sigma_m = GpsSigma(inputs.gnss, config);
-  r.batch = SolveHeadingBatch(epochs, gps_sigma_m, lat_rad, schuler_rate_rad_s, config);
+  r.batch = SolveHeadingBatch(epochs, gps_sigma_m, lat_rad, schuler_rate_radps, config);
   r.run_time_s = Seconds(start);
   r.gps_sigma_m = r.batch.gps_sigma_m;
 
@@ -151,7 +151,7 @@ MethodResult RunBatchMethod(const InflightInputs& inputs, const InflightConfig& 
           if (g.t_s <= prefix.back().t_s) fixes.push_back(g);
         }
         const BatchHeadingSolution s =
-            SolveHeadingBatch(prefix, GpsSigma(fixes, config), lat_rad, schuler_rate_rad_s, config);
+            SolveHeadingBatch(prefix, GpsSigma(fixes, config), lat_rad, schuler_rate_radps, config);
         // The prefix batch's heading at its last fix is yaw_free - dH_prefix, so its error
         // (yaw - yaw_true, the track's convention) is dH_true - dH_prefix.
         const double dh_true = YawError(prefix.back().yaw_free_rad, TruthYawAt(inputs.truth, prefix.back().t_s));
@@ -226,13 +226,13 @@ std::string MethodResultJson(const MethodResult& r) {
   JsonWriter w(out);
   w.BeginObject().Field("method", MethodName(r.method));
   w.Key("heading_error_arcmin_at_km").BeginObject();
-  for (std::size_t i = 0; i < r.at_km.size(); ++i) w.Field(KmText(r.at_km[i]), r.error_at_km_rad[i] * kRadToArcmin);
+  for (std::size_t i = 0; i < r.at_km.size(); ++i) w.Field(KmText(r.at_km[i]), r.error_at_km_rad[i] / kArcmin_rad);
   w.EndObject();
-  w.Field("final_heading_error_arcmin", r.final_error_rad * kRadToArcmin)
-      .Field("heading_sigma_arcmin", r.final_sigma_rad * kRadToArcmin)
+  w.Field("final_heading_error_arcmin", r.final_error_rad / kArcmin_rad)
+      .Field("heading_sigma_arcmin", r.final_sigma_rad / kArcmin_rad)
       .Field("run_time_s", r.run_time_s);
   w.Key("heading_sigma_arcmin_at_km").BeginObject();
-  for (std::size_t i = 0; i < r.at_km.size(); ++i) w.Field(KmText(r.at_km[i]), r.sigma_at_km_rad[i] * kRadToArcmin);
+  for (std::size_t i = 0; i < r.at_km.size(); ++i) w.Field(KmText(r.at_km[i]), r.sigma_at_km_rad[i] / kArcmin_rad);
   w.EndObject();
   w.Field("path_length_km", r.track.empty() ? kNaN : r.track.back().path_length_m / 1000.0)
       .Field("gps_sigma_m", r.gps_sigma_m)
@@ -243,9 +243,9 @@ std::string MethodResultJson(const MethodResult& r) {
       w.BeginObject()
           .Field("t_s", c.t_s)
           .Field("path_length_km", c.path_length_m / 1000.0)
-          .Field("dh_arcmin", c.dh_rad * kRadToArcmin)
-          .Field("sigma_arcmin", c.sigma_rad * kRadToArcmin)
-          .Field("correction_arcmin", c.correction_rad * kRadToArcmin)
+          .Field("dh_arcmin", c.dh_rad / kArcmin_rad)
+          .Field("sigma_arcmin", c.sigma_rad / kArcmin_rad)
+          .Field("correction_arcmin", c.correction_rad / kArcmin_rad)
           .Field("samples", c.separation.samples)
           .Field("note", c.separation.note)
           .EndObject();
@@ -257,17 +257,14 @@ std::string MethodResultJson(const MethodResult& r) {
     const auto pair = [&](const std::string& key, const Eigen::Vector2d& v_ne, double scale) {
       w.Key(key).BeginArray().Value(v_ne[0] * scale).Value(v_ne[1] * scale).EndArray();
     };
-    constexpr double kRadToArcsec = kRadToDeg * 3600.0;
-    constexpr double kMps2ToUg = 1e6 / 9.80665;
-    constexpr double kRadpsToDegH = kRadToDeg * 3600.0;
     w.Key("batch").BeginObject();
-    w.Field("dh_arcmin", b.dh_rad * kRadToArcmin).Field("dh_sigma_arcmin", b.dh_sigma_rad * kRadToArcmin);
-    pair("level_ne_arcsec", b.level_rad, kRadToArcsec);
-    pair("level_sigma_ne_arcsec", b.level_sigma_rad, kRadToArcsec);
-    pair("accel_bias_ne_ug", b.accel_bias_ne_mps2, kMps2ToUg);
-    pair("accel_bias_sigma_ne_ug", b.accel_bias_sigma_mps2, kMps2ToUg);
-    pair("gyro_bias_ne_deg_h", b.gyro_bias_ne_radps, kRadpsToDegH);
-    pair("gyro_bias_sigma_ne_deg_h", b.gyro_bias_sigma_radps, kRadpsToDegH);
+    w.Field("dh_arcmin", b.dh_rad / kArcmin_rad).Field("dh_sigma_arcmin", b.dh_sigma_rad / kArcmin_rad);
+    pair("level_ne_arcsec", b.level_rad, 1.0 / kArcsec_rad);
+    pair("level_sigma_ne_arcsec", b.level_sigma_rad, 1.0 / kArcsec_rad);
+    pair("accel_bias_ne_ug", b.accel_bias_ne_mps2, 1.0 / kMicroG_mps2);
+    pair("accel_bias_sigma_ne_ug", b.accel_bias_sigma_mps2, 1.0 / kMicroG_mps2);
+    pair("gyro_bias_ne_deg_h", b.gyro_bias_ne_radps, 1.0 / kDegPerHour_radps);
+    pair("gyro_bias_sigma_ne_deg_h", b.gyro_bias_sigma_radps, 1.0 / kDegPerHour_radps);
     pair("position0_ne_m", b.position0_ne_m, 1.0);
     pair("velocity0_ne_mps", b.velocity0_ne_mps, 1.0);
     w.Field("fixes", b.fixes)
@@ -291,7 +288,7 @@ std::string MethodResultTable(const MethodResult& r) {
   const auto cell = [](double rad) {
     if (std::isnan(rad)) return std::string("-");
     char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3f", rad * kRadToArcmin);
+    std::snprintf(buf, sizeof buf, "%.3f", rad / kArcmin_rad);
     return std::string(buf);
   };
   for (std::size_t i = 0; i < r.at_km.size(); ++i) {
@@ -317,9 +314,9 @@ void WriteTrackCsv(const MethodResult& r, const std::string& path) {
   std::ostream& o = f.stream();
   o << "t_s,path_length_km,yaw_deg,sigma_arcmin,error_arcmin\n";
   for (const HeadingPoint& p : r.track) {
-    o << p.t_s << "," << p.path_length_m / 1000.0 << "," << p.yaw_rad * kRadToDeg << "," << p.sigma_rad * kRadToArcmin
+    o << p.t_s << "," << p.path_length_m / 1000.0 << "," << p.yaw_rad * kRadToDeg << "," << p.sigma_rad / kArcmin_rad
       << ",";
-    if (!std::isnan(p.error_rad)) o << p.error_rad * kRadToArcmin;  // empty: no truth
+    if (!std::isnan(p.error_rad)) o << p.error_rad / kArcmin_rad;  // empty: no truth
     o << "\n";
   }
   f.Commit();

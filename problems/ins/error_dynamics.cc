@@ -134,7 +134,7 @@ Eigen::MatrixXd ErrorDynamicsF(const InsState& x, const Eigen::Vector3d& f_b_mps
   const double sl = std::sin(lat), cl = std::cos(lat), tl = std::tan(lat);
   const double M = wgs84::MeridianRadius(lat), N = wgs84::PrimeVerticalRadius(lat);
   const double rm = M + h, rn = N + h;
-  const double w_e = wgs84::kOmegaIe_rad_s;
+  const double w_e = wgs84::kOmegaIe_radps;
   // dN/dlat (the radii vary with latitude; these e^2-small terms are kept).
   const double dN = N * wgs84::kE2 * sl * cl / (1.0 - wgs84::kE2 * sl * sl);
 

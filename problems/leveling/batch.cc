@@ -15,14 +15,14 @@
 #include <ceres/solver.h>
 #include <Eigen/Cholesky>
 
-#include "factors/leveling_vibration.h"
+#include "problems/leveling/leveling_vibration.h"
 #include "factors/state_prior.h"
 #include "core/leveling_model.h"
+#include "core/rotation.h"
 
 namespace navtwin::leveling {
 namespace {
 
-constexpr double kTwoPi = 2.0 * M_PI;
 /// Start scan: candidates f0 (1 + kScanStep i), |i| <= kScanHalfSteps (+-8 % in 2 % steps;
 /// the least-squares fit of a 0.2 s window changes over ~1/T = 5 Hz, far wider than a step).
 constexpr double kScanStep = 0.02;
@@ -431,7 +431,7 @@ BatchLevelingResult SolveLevelingBatch(const AccelWindow& window, const Leveling
   LevelEstimate& e = result.estimate;
   e.method = "batch";
   // The start is equation 1 (roll in [-pi, pi]); upside down a step may cross +-pi.
-  e.roll_rad = std::remainder(params.attitude[0], 2.0 * M_PI);
+  e.roll_rad = WrapPi(params.attitude[0]);
   e.pitch_rad = params.attitude[1];
   e.samples_used = n;
   e.fallback = model.fallback;

@@ -9,11 +9,11 @@
 #include <Eigen/LU>
 
 #include "core/leveling_model.h"
+#include "core/rotation.h"
 
 namespace navtwin::leveling {
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586;
 
 // Lower bound on the accelerometer noise (m/s^2, 0.1 ug): far below any real sensor, it
 // only keeps R > 0 on noise-free data whose estimated noise is zero.
@@ -220,7 +220,7 @@ void OnlineLeveler::ProcessBlock() {
   p_ = information.inverse();
   p_ = 0.5 * (p_ + p_.transpose());
   x_ += p_ * h.transpose() * innovation / r;
-  x_(0) = std::remainder(x_(0), kTwoPi);
+  x_(0) = WrapPi(x_(0));
 }
 
 bool OnlineLeveler::initialized() const { return blocks_ > 0; }

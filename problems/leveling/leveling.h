@@ -17,16 +17,16 @@
 #include <Eigen/Core>
 
 #include "core/signal.h"
+#include "core/units.h"
 
 namespace navtwin::leveling {
 
-constexpr double kStandardGravity_mps2 = 9.80665;  ///< CGPM 1901 standard gravity
 
 /// One window of accelerometer (and optionally gyro) samples at a nominally constant rate.
 struct AccelWindow {
   std::vector<double> t_s;                     ///< sample times (strictly increasing)
   std::vector<Eigen::Vector3d> f_b_mps2;       ///< specific force, body FRD
-  std::vector<Eigen::Vector3d> omega_b_rad_s;  ///< angular rate, body FRD; empty if unknown
+  std::vector<Eigen::Vector3d> omega_b_radps;  ///< angular rate, body FRD; empty if unknown
   double rate_hz = 0.0;                        ///< nominal sample rate
   std::string source;                          ///< file (or "simulation") for messages
   int size() const { return static_cast<int>(f_b_mps2.size()); }
@@ -50,11 +50,11 @@ struct LevelingOptions {
   /// need the estimate).
   bool batch_covariance = true;
   /// Input checks: accelerometer full-scale range (|f| per axis at or beyond 99.5 % of it
-  /// counts as saturated); motion when the mean |omega| exceeds max_rate_rad_s or the
+  /// counts as saturated); motion when the mean |omega| exceeds max_rate_radps or the
   /// period-averaged |f| differs from gravity_mps2 (or 9.80665 when estimated) by more
   /// than max_gravity_mismatch_mps2.
   double accel_range_mps2 = 16.0 * kStandardGravity_mps2;
-  double max_rate_rad_s = 0.05;
+  double max_rate_radps = 0.05;
   double max_gravity_mismatch_mps2 = 0.5;
 };
 

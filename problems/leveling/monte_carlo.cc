@@ -12,12 +12,11 @@
 #include "problems/leveling/batch.h"
 #include "problems/leveling/filter.h"
 #include "core/leveling_model.h"
+#include "core/units.h"
 
 namespace navtwin::leveling {
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586;
-constexpr double kMilliG_mps2 = 1e-3 * kStandardGravity_mps2;
 constexpr int kMethods = 4;
 const char* const kMethodNames[kMethods] = {"plain_mean", "period_average", "filter", "batch"};
 
@@ -51,7 +50,7 @@ const Method kMethodFunctions[kMethods] = {&PlainMean, &PeriodAverage, &RunFilte
 
 RunOutcome Outcome(const LevelEstimate& e, double roll_rad, double pitch_rad) {
   RunOutcome o;
-  o.roll_error_rad = std::remainder(e.roll_rad - roll_rad, kTwoPi);
+  o.roll_error_rad = WrapPi(e.roll_rad - roll_rad);
   o.pitch_error_rad = e.pitch_rad - pitch_rad;
   o.roll_sigma_rad = e.roll_sigma_rad;
   o.pitch_sigma_rad = e.pitch_sigma_rad;

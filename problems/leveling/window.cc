@@ -114,17 +114,17 @@ Eigen::Vector3d PeriodMean(const AccelWindow& w, const LevelingOptions& options)
 }
 
 // Motion: a mean angular rate (the norm of the mean omega, in which zero-mean vibration of
-// the gyros cancels) above max_rate_rad_s, or a mean |f| far from gravity.
+// the gyros cancels) above max_rate_radps, or a mean |f| far from gravity.
 bool CheckMotion(const AccelWindow& w, const LevelingOptions& options, std::string* message) {
   bool moving = false;
-  if (!w.omega_b_rad_s.empty()) {
+  if (!w.omega_b_radps.empty()) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& o : w.omega_b_rad_s) mean += o;
-    const double rate = (mean / static_cast<double>(w.omega_b_rad_s.size())).norm();
-    if (rate > options.max_rate_rad_s) {
+    for (const Eigen::Vector3d& o : w.omega_b_radps) mean += o;
+    const double rate = (mean / static_cast<double>(w.omega_b_radps.size())).norm();
+    if (rate > options.max_rate_radps) {
       moving = true;
       *message += Format("moving: mean angular rate %.4f rad/s (%.2f deg/s) exceeds %.4f rad/s\n", rate,
-                         rate * kRadToDeg, options.max_rate_rad_s);
+                         rate * kRadToDeg, options.max_rate_radps);
     }
   }
   const double g = options.gravity_mps2 > 0.0 ? options.gravity_mps2 : kStandardGravity_mps2;
@@ -147,7 +147,7 @@ AccelWindow WithoutMarked(const AccelWindow& w, const std::vector<bool>& marked)
     if (marked[k]) continue;
     if (!w.t_s.empty()) out.t_s.push_back(w.t_s[k]);
     out.f_b_mps2.push_back(w.f_b_mps2[k]);
-    if (!w.omega_b_rad_s.empty()) out.omega_b_rad_s.push_back(w.omega_b_rad_s[k]);
+    if (!w.omega_b_radps.empty()) out.omega_b_radps.push_back(w.omega_b_radps[k]);
   }
   return out.size() >= 2 ? out : w;
 }
@@ -179,7 +179,7 @@ AccelWindow ReadAccelWindow(const std::string& path, double start_s, double wind
     if (t_rel < start_s - kTimeSlack_s) continue;
     w.t_s.push_back(s.t_s);
     w.f_b_mps2.push_back(s.dv_b_mps / s.dt_s);
-    w.omega_b_rad_s.push_back(s.dtheta_b_rad / s.dt_s);
+    w.omega_b_radps.push_back(s.dtheta_b_rad / s.dt_s);
   }
   if (first) throw InputError(path, 0, "t_s", "no IMU samples");
   // The window may end up to one sample interval after the last sample (the time the

@@ -336,16 +336,16 @@ CoarseAlignment CoarseAlignAnsfl(const std::vector<ImuSample>& dot_imu, const st
 // settle_s 5 s: the paths last 13-55 s.
 TransferConfig AnsflDotConfig() {
   TransferConfig c;
-  c.gyro_bias_deg_h = 200.0;
-  c.gyro_arw_deg_sqrt_h = 8.0;
-  c.accel_bias_ug = 10000.0;
-  c.accel_vrw_m_s_sqrt_h = 7.0;
+  c.gyro_bias_radps = 200.0 * kDegPerHour_radps;
+  c.gyro_arw_rad_per_sqrt_s = 8.0 * kDegPerSqrtHour_radpsqrts;
+  c.accel_bias_mps2 = 10000.0 * kMicroG_mps2;
+  c.accel_vrw_mps_per_sqrt_s = 7.0 * kMpsPerSqrtHour_mpspsqrts;
   c.initial_velocity_mps = 0.2;
-  c.initial_attitude_deg = 1.0;
-  c.misalignment_deg = 2.0;
+  c.initial_attitude_rad = 1.0 * kDegToRad;
+  c.misalignment_rad = 2.0 * kDegToRad;
   c.delay_s = 0.05;
   c.delay_initial_s = 0.0;
-  c.master_attitude_mrad = 0.5;
+  c.master_attitude_rad = 0.5 * kMrad_rad;
   c.master_velocity_mps = 0.05;
   c.settle_s = 5.0;
   c.batch_state_interval_s = 0.1;
@@ -408,12 +408,12 @@ double ResidualAttitudeMrad(const std::vector<NavState>& gt, const TransferResul
     if (r.t_s[i] < t0_s + settle_s - 1e-9) continue;
     Quaterniond q_gt_t, q_gt_data;
     if (!slerp_at(r.t_s[i], &q_gt_t) || !slerp_at(r.t_s[i] + r.delay_s, &q_gt_data)) continue;
-    const Vector3d euler_est = EulerFromDcm(Matrix3d(q_gt_t.toRotationMatrix())) + r.error_mrad[i] * 1e-3;
+    const Vector3d euler_est = EulerFromDcm(Matrix3d(q_gt_t.toRotationMatrix())) + r.error_mrad[i] * kMrad_rad;
     const Matrix3d R_est = DcmFromEuler(euler_est.x(), euler_est.y(), euler_est.z());
     sum2 += LogSO3<double>(Matrix3d(R_est * q_gt_data.toRotationMatrix().transpose())).squaredNorm();
     ++n;
   }
-  return n == 0 ? std::nan("") : std::sqrt(sum2 / static_cast<double>(n)) * 1e3;
+  return n == 0 ? std::nan("") : std::sqrt(sum2 / static_cast<double>(n)) / kMrad_rad;
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 // Residuals (whitened):
 //   IMU preintegration i -> i+1 (factors/imu_preintegration.h; slave ARW and VRW of the
 //     configuration), linearised at zero biases;
-//   matching (factors/transfer_match.h = core/transfer_delay_model.h, second order, kCentral master
+//   matching (problems/transfer_alignment/transfer_match.h = problems/transfer_alignment/delay_model.h, second order, kCentral master
 //     derivatives) of state i with the record k whose data time tag_k - tau is nearest t_i:
 //     the master carried over dt = tau - (tag_k - t_i), |dt| <= half a record interval;
 //   priors: bg ~ N(0, gyro_bias), ba ~ N(0, accel_bias), q_b_s ~ the misalignment guess
@@ -35,12 +35,13 @@
 #include "core/earth.h"
 #include "core/imu_split.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "factors/attitude_prior.h"
 #include "factors/imu_preintegration.h"
 #include "factors/position_manifold.h"
 #include "factors/state_prior.h"
-#include "factors/transfer_match.h"
+#include "problems/transfer_alignment/transfer_match.h"
 #include "problems/transfer_alignment/master.h"
 #include "solvers/batch_driver.h"
 
@@ -48,9 +49,6 @@ namespace navtwin::transfer {
 namespace {
 
 constexpr double kTimeEps_s = 1e-6;
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kSqrtHour_s = 60.0;  // sqrt(3600 s)
-constexpr double kMicroG_mps2 = 9.80665e-6;
 /// Prior on the first state's position around the master's (the lever arm added): a gauge
 /// for the position, which no other residual fixes. 10 m covers the master's position
 /// carried over half a record interval (200 m/s x 10 ms = 2 m) and errors of a lever arm
@@ -70,13 +68,13 @@ void CheckConfig(const TransferConfig& c) {
       throw std::invalid_argument(std::string("SolveTransferBatch: config ") + name + " must be positive and finite");
     }
   };
-  positive(c.gyro_bias_deg_h, "gyro_bias_deg_h");
-  positive(c.gyro_arw_deg_sqrt_h, "gyro_arw_deg_sqrt_h");
-  positive(c.accel_bias_ug, "accel_bias_ug");
-  positive(c.accel_vrw_m_s_sqrt_h, "accel_vrw_m_s_sqrt_h");
-  positive(c.misalignment_deg, "misalignment_deg");
+  positive(c.gyro_bias_radps, "gyro_bias_radps");
+  positive(c.gyro_arw_rad_per_sqrt_s, "gyro_arw_rad_per_sqrt_s");
+  positive(c.accel_bias_mps2, "accel_bias_mps2");
+  positive(c.accel_vrw_mps_per_sqrt_s, "accel_vrw_mps_per_sqrt_s");
+  positive(c.misalignment_rad, "misalignment_rad");
   positive(c.delay_s, "delay_s");
-  positive(c.master_attitude_mrad, "master_attitude_mrad");
+  positive(c.master_attitude_rad, "master_attitude_rad");
   positive(c.master_velocity_mps, "master_velocity_mps");
   positive(c.batch_state_interval_s, "batch_state_interval_s");
   if (!std::isfinite(c.delay_initial_s) || !c.lever_arm_b_m.allFinite()) {
@@ -179,8 +177,8 @@ void TransferBatch::PlanStates() {
 
 void TransferBatch::Preintegrate() {
   // Slave white noise: deg/sqrt(h) -> rad/sqrt(s), m/s/sqrt(h) -> m/s/sqrt(s).
-  const double arw = cfg_.gyro_arw_deg_sqrt_h * kDegToRad / kSqrtHour_s;
-  const double vrw = cfg_.accel_vrw_m_s_sqrt_h / kSqrtHour_s;
+  const double arw = cfg_.gyro_arw_rad_per_sqrt_s;
+  const double vrw = cfg_.accel_vrw_mps_per_sqrt_s;
   const std::vector<ImuSample>& imu = in_.slave_imu;
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   // First sample ending after t_0; pieces of samples split at the state times.
@@ -240,7 +238,7 @@ int TransferBatch::SelectRecords() {
     const double lead_s = master_.record(k).t_s - s.t_s;
     s.match = problem_->AddResidualBlock(
         TransferMatch::Create(master_.kinematics(k), lead_s, DelayOrder::kSecond, cfg_.lever_arm_b_m,
-                              cfg_.master_attitude_mrad * 1e-3, cfg_.master_velocity_mps),
+                              cfg_.master_attitude_rad, cfg_.master_velocity_mps),
         nullptr, {s.q.data(), s.vel.data(), q_b_s_.data(), &tau_s_});
   }
   return changed;
@@ -271,11 +269,11 @@ void TransferBatch::BuildProblem() {
   SelectRecords();
 
   // Priors (see the file comment).
-  problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.gyro_bias_deg_h * kDegToRad / 3600.0),
+  problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.gyro_bias_radps),
                              nullptr, bg_.data());
-  problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.accel_bias_ug * kMicroG_mps2),
+  problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.accel_bias_mps2),
                              nullptr, ba_.data());
-  const double mis_sigma_rad = cfg_.misalignment_deg * kDegToRad;
+  const double mis_sigma_rad = cfg_.misalignment_rad;
   problem_->AddResidualBlock(
       AttitudePrior::Create(in_.misalignment_guess, Eigen::Matrix3d::Identity() / mis_sigma_rad), nullptr,
       q_b_s_.data());

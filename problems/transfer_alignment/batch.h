@@ -6,11 +6,11 @@
 // state, with the master record whose DATA time (tag - tau) is nearest the state (so the
 // series carries over at most half a record interval, not over tau; re-selected after
 // each solve at the new tau), the attitude and velocity matching residuals of
-// core/transfer_delay_model.h (second order, master derivatives kCentral; the delay enters through the
+// problems/transfer_alignment/delay_model.h (second order, master derivatives kCentral; the delay enters through the
 // compensation series, which is differentiable in tau) whitened by the master noise,
 // plus bias priors. The initial values come from the order-2 filter. Standard deviations
 // of the misalignment and the delay from ceres::Covariance. The matching residual
-// functor lives in factors/transfer_match.h (AutoDiff; checked against central
+// functor lives in problems/transfer_alignment/transfer_match.h (AutoDiff; checked against central
 // differences).
 #pragma once
 

@@ -1,7 +1,7 @@
 // Reading the transfer-alignment configuration (config.h). One flat YAML mapping whose
 // keys are the member names of TransferConfig (units in the names); every key is optional
 // and keeps the default of config.h when absent. Unknown keys, wrong types and values out
-// of range are InputError naming the file, the line and the key (core/sim/yaml_config.h).
+// of range are InputError naming the file, the line and the key (core/config/yaml_config.h).
 #include "problems/transfer_alignment/config.h"
 
 #include <cmath>
@@ -9,12 +9,11 @@
 #include <string>
 
 #include "core/io/input_error.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
+#include "core/units.h"
 
 namespace navtwin::transfer {
 namespace {
-
-using sim::ConfigNode;
 
 TransferConfig ParseRoot(const ConfigNode& n) {
   n.RequireKeys({"gyro_bias_deg_h", "gyro_arw_deg_sqrt_h", "accel_bias_ug", "accel_vrw_m_s_sqrt_h",
@@ -23,20 +22,22 @@ TransferConfig ParseRoot(const ConfigNode& n) {
                  "batch_state_interval_s", "batch_max_iterations"});
   TransferConfig c;
   // Slave sensor: biases and noise densities may be 0 (a sensor without that error).
-  c.gyro_bias_deg_h = n.NonNegative("gyro_bias_deg_h", c.gyro_bias_deg_h);
-  c.gyro_arw_deg_sqrt_h = n.NonNegative("gyro_arw_deg_sqrt_h", c.gyro_arw_deg_sqrt_h);
-  c.accel_bias_ug = n.NonNegative("accel_bias_ug", c.accel_bias_ug);
-  c.accel_vrw_m_s_sqrt_h = n.NonNegative("accel_vrw_m_s_sqrt_h", c.accel_vrw_m_s_sqrt_h);
+  c.gyro_bias_radps = n.NonNegativeSi("gyro_bias_deg_h", kDegPerHour_radps, c.gyro_bias_radps);
+  c.gyro_arw_rad_per_sqrt_s =
+      n.NonNegativeSi("gyro_arw_deg_sqrt_h", kDegPerSqrtHour_radpsqrts, c.gyro_arw_rad_per_sqrt_s);
+  c.accel_bias_mps2 = n.NonNegativeSi("accel_bias_ug", kMicroG_mps2, c.accel_bias_mps2);
+  c.accel_vrw_mps_per_sqrt_s =
+      n.NonNegativeSi("accel_vrw_m_s_sqrt_h", kMpsPerSqrtHour_mpspsqrts, c.accel_vrw_mps_per_sqrt_s);
   // Initial standard deviations: diagonal entries of P0, so > 0.
   c.initial_velocity_mps = n.Positive("initial_velocity_mps", c.initial_velocity_mps);
-  c.initial_attitude_deg = n.Positive("initial_attitude_deg", c.initial_attitude_deg);
-  c.misalignment_deg = n.Positive("misalignment_deg", c.misalignment_deg);
+  c.initial_attitude_rad = n.PositiveSi("initial_attitude_deg", kDegToRad, c.initial_attitude_rad);
+  c.misalignment_rad = n.PositiveSi("misalignment_deg", kDegToRad, c.misalignment_rad);
   c.delay_s = n.Positive("delay_s", c.delay_s);
   // The delay's initial guess: a time shift, any finite value (the reader checks finiteness).
   c.delay_initial_s = n.Double("delay_initial_s", c.delay_initial_s);
   if (!std::isfinite(c.delay_initial_s)) n.Fail("delay_initial_s", "must be finite");
   // Master measurement noise: the R matrix of the filter and the batch's whitening, so > 0.
-  c.master_attitude_mrad = n.Positive("master_attitude_mrad", c.master_attitude_mrad);
+  c.master_attitude_rad = n.PositiveSi("master_attitude_mrad", kMrad_rad, c.master_attitude_rad);
   c.master_velocity_mps = n.Positive("master_velocity_mps", c.master_velocity_mps);
   c.master_fit_window_s = n.NonNegative("master_fit_window_s", c.master_fit_window_s);
   c.lever_arm_b_m = n.Vector("lever_arm_b_m", c.lever_arm_b_m);
@@ -49,10 +50,10 @@ TransferConfig ParseRoot(const ConfigNode& n) {
 
 }  // namespace
 
-TransferConfig LoadTransferConfig(const std::string& path) { return ParseRoot(sim::LoadYamlFile(path)); }
+TransferConfig LoadTransferConfig(const std::string& path) { return ParseRoot(LoadYamlFile(path)); }
 
 TransferConfig ParseTransferConfig(const std::string& yaml_text, const std::string& file) {
-  return ParseRoot(sim::ParseYaml(yaml_text, file));
+  return ParseRoot(ParseYaml(yaml_text, file));
 }
 
 }  // namespace navtwin::transfer

@@ -1,5 +1,6 @@
-// Configuration of transfer alignment (seed 002, issue 6). YAML keys carry units;
-// unknown keys are errors naming file, line and key. Defaults: the preset
+// Configuration of transfer alignment (seed 002, issue 6). YAML keys carry people units
+// (gyro_bias_deg_h, accel_bias_ug, master_attitude_mrad, ...), converted to the SI members
+// below as the file is read; unknown keys are errors naming file, line and key. Defaults: the preset
 // transfer-alignment-high-maneuver's slave (tactical grade) and master.
 #pragma once
 
@@ -7,22 +8,25 @@
 
 #include <Eigen/Core>
 
+#include "core/units.h"
+
 namespace navtwin::transfer {
 
 struct TransferConfig {
   // Slave IMU specification (1 sigma).
-  double gyro_bias_deg_h = 1.0;
-  double gyro_arw_deg_sqrt_h = 0.05;
-  double accel_bias_ug = 200.0;
-  double accel_vrw_m_s_sqrt_h = 0.05;
+  double gyro_bias_radps = 1.0 * kDegPerHour_radps;                      ///< key gyro_bias_deg_h
+  double gyro_arw_rad_per_sqrt_s = 0.05 * kDegPerSqrtHour_radpsqrts;     ///< key gyro_arw_deg_sqrt_h
+  double accel_bias_mps2 = 200.0 * kMicroG_mps2;                         ///< key accel_bias_ug
+  double accel_vrw_mps_per_sqrt_s = 0.05 * kMpsPerSqrtHour_mpspsqrts;    ///< key accel_vrw_m_s_sqrt_h
   // Initial uncertainty (1 sigma).
   double initial_velocity_mps = 1.0;
-  double initial_attitude_deg = 2.0;
-  double misalignment_deg = 2.0;   ///< of the misalignment around its initial guess (0 = identity)
+  double initial_attitude_rad = 2.0 * kDegToRad;  ///< key initial_attitude_deg
+  double misalignment_rad = 2.0 * kDegToRad;      ///< key misalignment_deg; of the misalignment around
+                                                  ///< its initial guess (0 = identity)
   double delay_s = 0.5;            ///< of the delay around its initial guess
   double delay_initial_s = 0.0;    ///< initial guess of the delay
   // Master measurement noise (1 sigma): attitude per axis and velocity per axis.
-  double master_attitude_mrad = 0.5;
+  double master_attitude_rad = 0.5 * kMrad_rad;  ///< key master_attitude_mrad
   double master_velocity_mps = 0.05;
   /// The filter's master derivatives (omega, omega_dot, a, a_dot): a causal least-squares
   /// quadratic over this window of records (master.h); 0 = first and second differences
@@ -41,7 +45,8 @@ struct TransferConfig {
   int batch_max_iterations = 30;
 };
 
-/// Reads a YAML file (keys = the member names above; lever_arm_b_m as [x, y, z]).
+/// Reads a YAML file (keys = the member names above, or the people-unit key named beside a
+/// member; lever_arm_b_m as [x, y, z]).
 TransferConfig LoadTransferConfig(const std::string& path);
 TransferConfig ParseTransferConfig(const std::string& yaml_text, const std::string& file);
 

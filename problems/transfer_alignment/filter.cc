@@ -17,7 +17,7 @@
 //
 // Update at every master record whose tag lies inside the slave span: the INS is stepped
 // to the tag, its position reset from the record carried forward over tau (the record
-// holds the master's position at tag - tau), and the matching residuals of core/transfer_delay_model.h
+// holds the master's position at tag - tau), and the matching residuals of problems/transfer_alignment/delay_model.h
 //   r = [v_s - v_pred(tau) - R_pred (omega x l);  Log(R_n_s (R_pred(tau) M)^T)]
 // evaluated at the estimate. At the truth r = 0 + noise, so 0 ~ r + H dx + v and the
 // innovation is y = -r ~ H dx (H = dr/d(dx), MatchResidualAndJacobian), relinearised
@@ -47,6 +47,7 @@
 #include "core/imu_split.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
+#include "core/units.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/ins/ins_state.h"
 #include "problems/transfer_alignment/master.h"
@@ -79,9 +80,6 @@ constexpr int kAtt = 3;
 constexpr int kMis = 6;
 constexpr int kTau = 9;
 
-constexpr double kDegPerHour = kDegToRad / 3600.0;
-constexpr double kPerSqrtHour = 1.0 / 60.0;  // 1/sqrt(h) = 1/(60 sqrt(s))
-constexpr double kMicroG = 9.80665e-6;
 // Memory over which an unestimated slave bias is covered by process noise (see the header
 // comment): the attitude matching observes phi at 50 Hz, so the filter's memory of phi is
 // seconds; 10 s makes the bias term about equal to the tactical ARW term.
@@ -95,26 +93,6 @@ constexpr double kTimeEpsilon_s = 1e-9;
 constexpr double kGateProbability = 1.0;  // no gate: see the header comment
 constexpr int kUpdateIterations = 3;
 
-// SO(3) Jacobians (rotation-vector calculus):
-//   Exp(x + d) = Exp(x) Exp(Jr(x) d) + O(d^2),   Log(Exp(x) Exp(d)) = x + Jr^-1(x) d,
-//   Log(Exp(d) Exp(x)) = x + Jl^-1(x) d,  Jl(x) = Jr(-x).
-Matrix3d RightJacobian(const Vector3d& x) {
-  const double t2 = x.squaredNorm();
-  const Matrix3d S = Skew<double>(x);
-  if (t2 < 1e-10) return Matrix3d::Identity() - 0.5 * S + S * S / 6.0;
-  const double t = std::sqrt(t2);
-  return Matrix3d::Identity() - (1.0 - std::cos(t)) / t2 * S + (t - std::sin(t)) / (t2 * t) * S * S;
-}
-
-Matrix3d InverseRightJacobian(const Vector3d& x) {
-  const double t2 = x.squaredNorm();
-  const Matrix3d S = Skew<double>(x);
-  if (t2 < 1e-10) return Matrix3d::Identity() + 0.5 * S + S * S / 12.0;
-  const double t = std::sqrt(t2);
-  const double c = 1.0 / t2 - (1.0 + std::cos(t)) / (2.0 * t * std::sin(t));
-  return Matrix3d::Identity() + 0.5 * S + c * S * S;
-}
-
 void Require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("RunTransferFilter: configuration: " + what);
 }
@@ -122,16 +100,16 @@ void Require(bool ok, const std::string& what) {
 void CheckConfig(const TransferConfig& c) {
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
   auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
-  Require(non_negative(c.gyro_bias_deg_h), "gyro_bias_deg_h must be >= 0");
-  Require(non_negative(c.gyro_arw_deg_sqrt_h), "gyro_arw_deg_sqrt_h must be >= 0");
-  Require(non_negative(c.accel_bias_ug), "accel_bias_ug must be >= 0");
-  Require(non_negative(c.accel_vrw_m_s_sqrt_h), "accel_vrw_m_s_sqrt_h must be >= 0");
+  Require(non_negative(c.gyro_bias_radps), "gyro_bias_radps must be >= 0");
+  Require(non_negative(c.gyro_arw_rad_per_sqrt_s), "gyro_arw_rad_per_sqrt_s must be >= 0");
+  Require(non_negative(c.accel_bias_mps2), "accel_bias_mps2 must be >= 0");
+  Require(non_negative(c.accel_vrw_mps_per_sqrt_s), "accel_vrw_mps_per_sqrt_s must be >= 0");
   Require(positive(c.initial_velocity_mps), "initial_velocity_mps must be > 0");
-  Require(positive(c.initial_attitude_deg), "initial_attitude_deg must be > 0");
-  Require(positive(c.misalignment_deg), "misalignment_deg must be > 0");
+  Require(positive(c.initial_attitude_rad), "initial_attitude_rad must be > 0");
+  Require(positive(c.misalignment_rad), "misalignment_rad must be > 0");
   Require(positive(c.delay_s), "delay_s must be > 0");
   Require(std::isfinite(c.delay_initial_s), "delay_initial_s must be finite");
-  Require(positive(c.master_attitude_mrad), "master_attitude_mrad must be > 0");
+  Require(positive(c.master_attitude_rad), "master_attitude_rad must be > 0");
   Require(positive(c.master_velocity_mps), "master_velocity_mps must be > 0");
   Require(c.lever_arm_b_m.allFinite(), "lever_arm_b_m must be finite");
 }
@@ -154,9 +132,9 @@ class TransferFilter {
         ins_(in.slave_initial), kf_(InitialCovariance(cfg)) {
     misalignment_ = in.misalignment_guess.normalized();
     tau_s_ = cfg.delay_initial_s;
-    noise_.gyro_arw_rad_per_sqrt_s = cfg.gyro_arw_deg_sqrt_h * kDegToRad * kPerSqrtHour;
-    noise_.accel_vrw_mps_per_sqrt_s = cfg.accel_vrw_m_s_sqrt_h * kPerSqrtHour;
-    const double bg = cfg.gyro_bias_deg_h * kDegPerHour, ba = cfg.accel_bias_ug * kMicroG;
+    noise_.gyro_arw_rad_per_sqrt_s = cfg.gyro_arw_rad_per_sqrt_s;
+    noise_.accel_vrw_mps_per_sqrt_s = cfg.accel_vrw_mps_per_sqrt_s;
+    const double bg = cfg.gyro_bias_radps, ba = cfg.accel_bias_mps2;
     q_.segment<3>(kVel).setConstant(std::pow(noise_.accel_vrw_mps_per_sqrt_s, 2) + ba * ba * kBiasMemory_s);
     q_.segment<3>(kAtt).setConstant(std::pow(noise_.gyro_arw_rad_per_sqrt_s, 2) + bg * bg * kBiasMemory_s);
     q_.segment<3>(kMis).setConstant(kMisalignmentWalk_rad_sqrt_s * kMisalignmentWalk_rad_sqrt_s);
@@ -199,8 +177,8 @@ class TransferFilter {
     CheckConfig(c);
     Vector10 sd;
     sd.segment<3>(kVel).setConstant(c.initial_velocity_mps);
-    sd.segment<3>(kAtt).setConstant(c.initial_attitude_deg * kDegToRad);
-    sd.segment<3>(kMis).setConstant(c.misalignment_deg * kDegToRad);
+    sd.segment<3>(kAtt).setConstant(c.initial_attitude_rad);
+    sd.segment<3>(kMis).setConstant(c.misalignment_rad);
     sd(kTau) = c.delay_s;
     return Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal());
   }
@@ -305,7 +283,7 @@ class TransferFilter {
     }
     Eigen::Matrix<double, 6, 1> sigma;
     sigma.head<3>().setConstant(std::hypot(gain_v * cfg_.master_velocity_mps, trunc_vel));
-    sigma.tail<3>().setConstant(std::hypot(cfg_.master_attitude_mrad * 1e-3, trunc_att));
+    sigma.tail<3>().setConstant(std::hypot(cfg_.master_attitude_rad, trunc_att));
     return sigma;
   }
 
@@ -333,7 +311,7 @@ void MatchResidualAndJacobian(const Matrix3d& R_n_s, const Vector3d& v_n_s_mps, 
                               const MasterKinematics& m, double tau_s, DelayOrder order,
                               const Vector3d& lever_arm_b_m, Eigen::Matrix<double, 6, 1>* r,
                               Eigen::Matrix<double, 6, kTransferStates>* H) {
-  // Residuals from the one model (core/transfer_delay_model.h).
+  // Residuals from the one model (problems/transfer_alignment/delay_model.h).
   r->head<3>() = VelocityMatchResidual<double>(v_n_s_mps, m, tau_s, order, lever_arm_b_m);
   const Vector3d r_att = AttitudeMatchResidual<double>(R_n_s, R_b_s, m, tau_s, order);
   r->tail<3>() = r_att;
@@ -344,7 +322,7 @@ void MatchResidualAndJacobian(const Matrix3d& R_n_s, const Vector3d& v_n_s_mps, 
   if (order == DelayOrder::kSecond) dtheta_dtau += m.omega_dot_nb_b_radps2 * tau_s;
   const Matrix3d C = CompensatedMasterDcm<double>(m, tau_s, order);
   // C(tau + d) = C Exp(u d) with u = Jr(theta) dtheta/dtau (body axes of the prediction).
-  const Vector3d u = RightJacobian(theta) * dtheta_dtau;
+  const Vector3d u = RightJacobianSO3(theta) * dtheta_dtau;
 
   H->setZero();
   // Velocity rows. d r_vel / d dv = I.
@@ -367,8 +345,8 @@ void MatchResidualAndJacobian(const Matrix3d& R_n_s, const Vector3d& v_n_s_mps, 
   //        = E Exp(-C mu): Log(E Exp(-C mu)) = r - Jr^-1(r) C mu.
   //   tau: C(tau + d)^T = Exp(-u d) C^T, so E -> E C Exp(-u d) C^T = E Exp(-C u d):
   //        d r / d tau = -Jr^-1(r) C u.
-  const Matrix3d Jr_inv = InverseRightJacobian(r_att);
-  H->block<3, 3>(3, kAtt) = InverseRightJacobian(-r_att);
+  const Matrix3d Jr_inv = RightJacobianInverseSO3(r_att);
+  H->block<3, 3>(3, kAtt) = RightJacobianInverseSO3<double>(-r_att);
   H->block<3, 3>(3, kMis) = -Jr_inv * C;
   H->block<3, 1>(3, kTau) = -Jr_inv * C * u;
 }

@@ -4,7 +4,7 @@
 //   [6,9) mu_b_rad     misalignment residual, R_b_s_true = Exp(mu) R_b_s_est (master body axes)
 //   [9]   dtau_s       delay residual, tau_true = tau_est + dtau
 // with velocity matching (3) and attitude matching (3, rotation vector) against the
-// delay-compensated master (core/transfer_delay_model.h; order 1 or 2), at every master record. The
+// delay-compensated master (problems/transfer_alignment/delay_model.h; order 1 or 2), at every master record. The
 // slave INS is the project's strapdown (core/strapdown.h) on the raw slave IMU; position
 // is taken from the master (transfer alignment matches velocity and attitude, and the
 // position errors over a minute barely enter the velocity dynamics). Feedback after each
@@ -12,7 +12,7 @@
 // rotation vector as a quaternion multiplied into the slave quaternion, the misalignment
 // and delay residuals accumulated into the estimates the matcher uses. Jacobians of the
 // two residuals with respect to the states: analytic, checked against autodiff of the
-// core/transfer_delay_model.h residuals in the tests. Process noise: slave ARW / VRW, small random walks
+// problems/transfer_alignment/delay_model.h residuals in the tests. Process noise: slave ARW / VRW, small random walks
 // on misalignment and delay (flexure, clock wander; configurable).
 #pragma once
 
@@ -22,7 +22,7 @@
 #include <Eigen/Geometry>
 
 #include "problems/transfer_alignment/config.h"
-#include "core/transfer_delay_model.h"
+#include "problems/transfer_alignment/delay_model.h"
 #include "problems/transfer_alignment/inputs.h"
 
 namespace navtwin::transfer {
@@ -45,7 +45,7 @@ struct TransferFilterRun {
   double run_time_s = 0.0;
 };
 
-/// The matching residuals of core/transfer_delay_model.h at the estimate, r = [VelocityMatchResidual;
+/// The matching residuals of problems/transfer_alignment/delay_model.h at the estimate, r = [VelocityMatchResidual;
 /// AttitudeMatchResidual] (m/s, rad), and their analytic Jacobian H = dr/d(dx) with respect
 /// to the 10 error states above (exact: it includes the SO(3) Jacobians of the residual's
 /// Log and of the compensation's Exp; checked against autodiff in the tests). The filter's

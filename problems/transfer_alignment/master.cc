@@ -4,7 +4,7 @@
 // Attitude: the rate of the matrix R_n_b over an interval is the rotation vector of the
 // relative rotation, R_j = R_i Exp(omega dt) for a constant body rate omega = omega_nb^b
 // (the rate of R_n_b itself, transport rate included: exactly the quantity the delay
-// compensation R_n_b(t) = R_n_b(t - tau) Exp(theta) of core/transfer_delay_model.h carries forward).
+// compensation R_n_b(t) = R_n_b(t - tau) Exp(theta) of problems/transfer_alignment/delay_model.h carries forward).
 //   kCausal   omega_k     = Log(R_{k-1}^T R_k) / (t_k - t_{k-1})          (value at the
 //                            interval midpoint: lag (t_k - t_{k-1}) / 2)
 //             omega_dot_k = (omega_k - omega_{k-1}) / ((t_k - t_{k-2}) / 2) (the two

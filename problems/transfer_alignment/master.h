@@ -1,6 +1,6 @@
 // The master INS stream of transfer alignment: records as received (time tag = arrival),
 // each carrying the master's attitude and velocity at (tag - delay), and the derivatives
-// the delay compensation needs (core/transfer_delay_model.h): body rate omega_nb^b and its rate, and
+// the delay compensation needs (problems/transfer_alignment/delay_model.h): body rate omega_nb^b and its rate, and
 // dv_n/dt and its rate. A master navigation file holds attitude and velocity only (the
 // simulator's master.nav, the DJI solution of the ANSFL flights), so the derivatives are
 // estimated from the records (docs/transfer-alignment.md, "Derivatives of the master
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/types.h"
-#include "core/transfer_delay_model.h"
+#include "problems/transfer_alignment/delay_model.h"
 
 namespace navtwin::transfer {
 

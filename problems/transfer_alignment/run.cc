@@ -63,7 +63,7 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
   r.delay_s = last.delay_s;
   r.delay_sigma_s = last.sigma[9];
   r.misalignment_deg = EulerOf(last.misalignment) * kRadToDeg;
-  r.misalignment_sigma_mrad = last.sigma.segment<3>(6) * 1e3;
+  r.misalignment_sigma_mrad = last.sigma.segment<3>(6) / kMrad_rad;
   return r;
 }
 
@@ -79,7 +79,7 @@ TransferResult RunBatchMethod(const TransferInputs& inputs, const TransferConfig
   r.delay_s = sol.delay_s;
   r.delay_sigma_s = sol.delay_sigma_s;
   r.misalignment_deg = EulerOf(sol.misalignment) * kRadToDeg;
-  r.misalignment_sigma_mrad = sol.misalignment_sigma_rad * 1e3;
+  r.misalignment_sigma_mrad = sol.misalignment_sigma_rad / kMrad_rad;
   std::ostringstream note;
   note << (r.note.empty() ? "" : "; ") << "batch: " << sol.states.size() << " states, " << sol.iterations
        << " iterations, final cost " << sol.final_cost;
@@ -118,7 +118,7 @@ void ScoreAttitude(const TransferInputs& inputs, const std::vector<NavState>& sl
   if (inputs.true_misalignment) {
     const Eigen::Quaterniond& m_true = *inputs.true_misalignment;
     r->misalignment_true_deg = EulerOf(m_true) * kRadToDeg;
-    r->misalignment_error_mrad = LogSO3(Eigen::Matrix3d((m_true * misalignment_est.conjugate()).toRotationMatrix())).norm() * 1e3;
+    r->misalignment_error_mrad = LogSO3(Eigen::Matrix3d((m_true * misalignment_est.conjugate()).toRotationMatrix())).norm() / kMrad_rad;
   } else {
     r->misalignment_true_deg.setConstant(kNaN);
     r->misalignment_error_mrad = kNaN;
@@ -141,7 +141,7 @@ void ScoreAttitude(const TransferInputs& inputs, const std::vector<NavState>& sl
     const Eigen::Quaterniond q_true = slave_truth ? *q_n_b_true * *inputs.true_misalignment : *q_n_b_true;
     const Eigen::Quaterniond q_est = slave_truth ? s.q_n_b : s.q_n_b * misalignment_est.conjugate();
     const Eigen::Vector3d d = EulerOf(q_est) - EulerOf(q_true);
-    const Eigen::Vector3d e_mrad(WrapPi(d.x()) * 1e3, WrapPi(d.y()) * 1e3, WrapPi(d.z()) * 1e3);
+    const Eigen::Vector3d e_mrad(WrapPi(d.x()) / kMrad_rad, WrapPi(d.y()) / kMrad_rad, WrapPi(d.z()) / kMrad_rad);
     r->t_s.push_back(s.t_s);
     r->error_mrad.push_back(e_mrad);
     if (s.t_s < t_settled - 1e-9) continue;

@@ -111,7 +111,7 @@ TEST_F(CalibrateMagTest, EllipsoidOnARateTableRecoversTheHardIronAndTheHeading) 
   Eigen::Matrix3d I_plus_S = Eigen::Matrix3d::Identity();
   for (int r_ = 0; r_ < 3; ++r_)
     for (int c = 0; c < 3; ++c) I_plus_S(r_, c) += truth["soft_iron"][r_][c].as<double>();
-  const Eigen::Matrix3d product = file.mag->soft_iron * I_plus_S;
+  const Eigen::Matrix3d product = file.mag->correction * I_plus_S;
   const double k = product.trace() / 3.0;
   // The soft iron's sigma is ~0.3 uT / 42 uT / sqrt(400) = 4e-4; 0.005 is ~10 sigma.
   EXPECT_LT((product / k - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 0.005) << product;

@@ -26,13 +26,13 @@ TEST(AnalyticTrajectory, MechanizationReproducesOneHourDemoFlight) {
 TEST(AnalyticTrajectory, SpecificForceAtRestIsMinusGravity) {
   struct Still : AnalyticTrajectory {
     Eigen::Vector3d Euler_rad(double) const override { return Eigen::Vector3d::Zero(); }
-    Eigen::Vector3d EulerRate_rad_s(double) const override { return Eigen::Vector3d::Zero(); }
+    Eigen::Vector3d EulerRate_radps(double) const override { return Eigen::Vector3d::Zero(); }
     Eigen::Vector3d Velocity_n_mps(double) const override { return Eigen::Vector3d::Zero(); }
     Eigen::Vector3d Acceleration_n_mps2(double) const override { return Eigen::Vector3d::Zero(); }
   } still;
   const BodyKinematics k = BodyKinematicsAt(still, 0.0, 0.3, 10.0);
   EXPECT_NEAR(k.f_b_mps2.z(), -wgs84::NormalGravity(0.3, 10.0), 1e-12);
-  EXPECT_NEAR((k.omega_ib_b_rad_s - wgs84::EarthRateNed(0.3)).norm(), 0.0, 1e-18);
+  EXPECT_NEAR((k.omega_ib_b_radps - wgs84::EarthRateNed(0.3)).norm(), 0.0, 1e-18);
 }
 
 }  // namespace

@@ -87,7 +87,7 @@ TEST_F(CalibrationFileTest, WriteReadRoundTripIsExact) {
   f.imu = c;
   MagCorrection m;
   m.hard_iron_uT = Eigen::Vector3d(12.25, -3.5, 0.1);
-  m.soft_iron << 1.02, 0.01, -0.003, 0.01, 0.97, 0.002, -0.003, 0.002, 1.01;
+  m.correction << 1.02, 0.01, -0.003, 0.01, 0.97, 0.002, -0.003, 0.002, 1.01;
   m.field_uT = 49.87;
   f.mag = m;
 
@@ -110,7 +110,7 @@ TEST_F(CalibrationFileTest, WriteReadRoundTripIsExact) {
   EXPECT_TRUE(r.imu->temperature->gyro_scale_factor.empty());
   EXPECT_TRUE(r.imu->temperature->accel_bias_mps2.empty());
   EXPECT_EQ(r.mag->hard_iron_uT, m.hard_iron_uT);
-  EXPECT_EQ(r.mag->soft_iron, m.soft_iron);
+  EXPECT_EQ(r.mag->correction, m.correction);
   EXPECT_EQ(r.mag->field_uT, m.field_uT);
   // Sections are optional: a mag-only file reads back without an imu.
   CalibrationFile mag_only;
@@ -291,7 +291,7 @@ TEST_F(CalibrationFileTest, OpenOverloadsApplyTheFile) {
   file.imu->temperature = t;
   file.mag = MagCorrection();
   file.mag->hard_iron_uT = Eigen::Vector3d(3, -2, 1);
-  file.mag->soft_iron = Eigen::Vector3d(1.1, 0.9, 1.0).asDiagonal();
+  file.mag->correction = Eigen::Vector3d(1.1, 0.9, 1.0).asDiagonal();
   const std::string cal = dir_ + "/cal.yaml";
   WriteCalibrationFile(cal, file);
 

@@ -41,9 +41,9 @@ TEST(Earth, NormalGravityMatchesPublishedValues) {
 TEST(Earth, RatesInNed) {
   const double lat = 45.0 * kDegToRad;
   const Eigen::Vector3d w = EarthRateNed(lat);
-  EXPECT_NEAR(w.norm(), kOmegaIe_rad_s, 1e-18);
-  EXPECT_NEAR(w.x(), kOmegaIe_rad_s * std::sqrt(0.5), 1e-18);
-  EXPECT_NEAR(w.z(), -kOmegaIe_rad_s * std::sqrt(0.5), 1e-18);
+  EXPECT_NEAR(w.norm(), kOmegaIe_radps, 1e-18);
+  EXPECT_NEAR(w.x(), kOmegaIe_radps * std::sqrt(0.5), 1e-18);
+  EXPECT_NEAR(w.z(), -kOmegaIe_radps * std::sqrt(0.5), 1e-18);
   // Flying east at 100 m/s on the equator: the frame turns about north at v / R_N.
   const Eigen::Vector3d r = TransportRateNed(0.0, 0.0, Eigen::Vector3d(0, 100, 0));
   EXPECT_NEAR(r.x(), 100.0 / kA_m, 1e-18);

@@ -6,16 +6,16 @@
 
 #include "core/rotation.h"
 #include "core/sim/random.h"
+#include "core/units.h"
 
 namespace navtwin::leveling {
 namespace {
 
-constexpr double kG = 9.80665;
 
 TEST(LevelingModelTest, EquationOneInvertsTheModelInEveryQuadrant) {
   for (double roll_deg : {-170.0, -95.0, -30.0, 0.0, 12.0, 89.0, 135.0}) {
     for (double pitch_deg : {-85.0, -20.0, 0.0, 7.5, 60.0}) {
-      const Eigen::Vector3d f = SpecificForceAtRest(roll_deg * kDegToRad, pitch_deg * kDegToRad, kG);
+      const Eigen::Vector3d f = SpecificForceAtRest(roll_deg * kDegToRad, pitch_deg * kDegToRad, kStandardGravity_mps2);
       const RollPitch rp = LevelFromSpecificForce(f);
       // atan2 of exact model values: rounding only.
       EXPECT_NEAR(rp.roll_rad, roll_deg * kDegToRad, 1e-12);
@@ -28,14 +28,14 @@ TEST(LevelingModelTest, ModelIsGravityRotatedIntoTheBody) {
   // f_b = R_b_n (0, 0, -g) with R_n_b from roll, pitch (yaw does not matter).
   const double roll = 0.3, pitch = -0.2;
   const Eigen::Matrix3d r_n_b = DcmFromEuler(roll, pitch, 1.1);
-  const Eigen::Vector3d expected = r_n_b.transpose() * Eigen::Vector3d(0.0, 0.0, -kG);
-  EXPECT_NEAR((SpecificForceAtRest(roll, pitch, kG) - expected).norm(), 0.0, 1e-12);
+  const Eigen::Vector3d expected = r_n_b.transpose() * Eigen::Vector3d(0.0, 0.0, -kStandardGravity_mps2);
+  EXPECT_NEAR((SpecificForceAtRest(roll, pitch, kStandardGravity_mps2) - expected).norm(), 0.0, 1e-12);
 }
 
 TEST(LevelingModelTest, LevelJacobianMatchesCentralDifferences) {
   sim::Rng rng(21);
   for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::Vector3d f = SpecificForceAtRest(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.4, 1.4), kG) +
+    const Eigen::Vector3d f = SpecificForceAtRest(rng.Uniform(-1.5, 1.5), rng.Uniform(-1.4, 1.4), kStandardGravity_mps2) +
                               rng.Normal3(0.5);
     const Eigen::Matrix<double, 2, 3> j = LevelJacobian(f);
     const double h = 1e-6;

@@ -150,5 +150,60 @@ TEST(Rotation, WrapPi) {
   EXPECT_NEAR(WrapPi(-7.0), -7.0 + 2 * M_PI, 1e-12);
 }
 
+TEST(Rotation, WrapPiKeepsAJetDerivative) {
+  using J = ceres::Jet<double, 1>;
+  const J w = WrapPi(J(7.0, 0));
+  EXPECT_NEAR(w.a, 7.0 - 2 * M_PI, 1e-12);
+  EXPECT_EQ(w.v[0], 1.0);
+}
+
+// Central differences of Exp/Log, step h: truncation O(h^2) ~ 1e-10 and rounding
+// ~ 1e-16 / h ~ 1e-11 on unit-scale entries, so 1e-8 is a margin of 100.
+constexpr double kStep = 1e-5;
+constexpr double kJacobianTol = 1e-8;
+
+/// Column i: (Log(Exp(phi)^T Exp(phi + h e_i)) - Log(Exp(phi)^T Exp(phi - h e_i))) / 2h.
+Eigen::Matrix3d NumericRightJacobian(const Eigen::Vector3d& phi) {
+  const Eigen::Matrix3d Rt = ExpSO3(phi).transpose();
+  Eigen::Matrix3d J;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d d = kStep * Eigen::Vector3d::Unit(i);
+    const Eigen::Matrix3d Rp = Rt * ExpSO3<double>(phi + d), Rm = Rt * ExpSO3<double>(phi - d);
+    J.col(i) = (LogSO3(Rp) - LogSO3(Rm)) / (2.0 * kStep);
+  }
+  return J;
+}
+
+/// Column i: (Log(Exp(phi) Exp(h e_i)) - Log(Exp(phi) Exp(-h e_i))) / 2h.
+Eigen::Matrix3d NumericRightJacobianInverse(const Eigen::Vector3d& phi) {
+  const Eigen::Matrix3d R = ExpSO3(phi);
+  Eigen::Matrix3d J;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d d = kStep * Eigen::Vector3d::Unit(i);
+    const Eigen::Matrix3d Rp = R * ExpSO3<double>(d), Rm = R * ExpSO3<double>(-d);
+    J.col(i) = (LogSO3(Rp) - LogSO3(Rm)) / (2.0 * kStep);
+  }
+  return J;
+}
+
+TEST(Rotation, RightJacobianAndItsInverseMatchCentralDifferences) {
+  std::mt19937 rng(20261127);
+  const Eigen::Vector3d random = RandomRotVec(&rng, 2.5);
+  const Eigen::Vector3d tiny = 1e-8 * Eigen::Vector3d(0.6, -0.8, 0.0);
+  for (const Eigen::Vector3d& phi : {Eigen::Vector3d::Zero().eval(), tiny, random}) {
+    SCOPED_TRACE(phi.transpose());
+    const Eigen::Matrix3d Jr = RightJacobianSO3(phi), Jr_inv = RightJacobianInverseSO3(phi);
+    EXPECT_LT((Jr - NumericRightJacobian(phi)).cwiseAbs().maxCoeff(), kJacobianTol);
+    EXPECT_LT((Jr_inv - NumericRightJacobianInverse(phi)).cwiseAbs().maxCoeff(), kJacobianTol);
+    EXPECT_LT((Jr * Jr_inv - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), kTol);
+  }
+  // At zero both are the identity exactly; the two branches agree where they meet.
+  EXPECT_EQ(RightJacobianSO3(Eigen::Vector3d::Zero().eval()), Eigen::Matrix3d::Identity());
+  EXPECT_EQ(RightJacobianInverseSO3(Eigen::Vector3d::Zero().eval()), Eigen::Matrix3d::Identity());
+  const Eigen::Vector3d below(0.99e-4, 0.0, 0.0), above(1.01e-4, 0.0, 0.0);
+  EXPECT_LT((RightJacobianSO3(below) - RightJacobianSO3(above)).norm(), 1e-5);
+  EXPECT_LT((RightJacobianInverseSO3(below) - RightJacobianInverseSO3(above)).norm(), 1e-5);
+}
+
 }  // namespace
 }  // namespace navtwin

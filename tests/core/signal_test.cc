@@ -6,11 +6,11 @@
 #include <gtest/gtest.h>
 
 #include "core/sim/random.h"
+#include "core/units.h"
 
 namespace navtwin::signal {
 namespace {
 
-constexpr double kTwoPi = 6.283185307179586;
 
 std::vector<Eigen::Vector3d> Sinusoid(int n, double period_samples, double amplitude, double phase,
                                       const Eigen::Vector3d& offset) {

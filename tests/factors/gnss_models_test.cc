@@ -18,6 +18,7 @@
 
 #include "core/earth.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "factors/position_manifold.h"
 #include "solvers/linearize.h"
@@ -30,7 +31,6 @@ using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, S
 
 const PositionManifold kPositionManifold;
 const AttitudeManifold kAttitudeManifold;
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -53,8 +53,8 @@ Eigen::Vector3d Eval(const ceres::CostFunction& f, const Eigen::Vector3d& a, con
 }
 
 TEST(GnssPosition, ZeroForTheTrueStateWithLeverArmAndAttitude) {
-  const Eigen::Vector3d pos(48.1 * kDeg, 11.6 * kDeg, 520.0);
-  const Eigen::Quaterniond q = QuatFromEuler(-5.0 * kDeg, 10.0 * kDeg, 100.0 * kDeg);
+  const Eigen::Vector3d pos(48.1 * kDegToRad, 11.6 * kDegToRad, 520.0);
+  const Eigen::Quaterniond q = QuatFromEuler(-5.0 * kDegToRad, 10.0 * kDegToRad, 100.0 * kDegToRad);
   const Eigen::Vector3d lever_b(0.8, -0.3, -1.5);
   // The antenna's true geodetic position, exact through ECEF.
   const Eigen::Vector3d p_ant = Offset(pos, DcmFromQuat(q) * lever_b);
@@ -68,8 +68,8 @@ TEST(GnssPosition, ZeroForTheTrueStateWithLeverArmAndAttitude) {
 }
 
 TEST(GnssPosition, OneMetreNorthErrorGivesPlusOneSigma) {
-  const Eigen::Vector3d truth(-33.9 * kDeg, 151.2 * kDeg, 40.0);
-  const Eigen::Quaterniond q = QuatFromEuler(2.0 * kDeg, -3.0 * kDeg, -140.0 * kDeg);
+  const Eigen::Vector3d truth(-33.9 * kDegToRad, 151.2 * kDegToRad, 40.0);
+  const Eigen::Quaterniond q = QuatFromEuler(2.0 * kDegToRad, -3.0 * kDegToRad, -140.0 * kDegToRad);
   const Eigen::Vector3d lever_b(0.2, 0.1, -0.9);
   const Eigen::Vector3d sigma(0.5, 0.8, 2.0);
   const Eigen::Vector3d p_ant = Offset(truth, DcmFromQuat(q) * lever_b);

@@ -23,6 +23,7 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/sim/truth.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "factors/position_manifold.h"
 
@@ -45,12 +46,12 @@ class Flight : public sim::AnalyticTrajectory {
   explicit Flight(const FlightShape& s) : s_(s) {}
 
   Eigen::Vector3d Euler_rad(double t) const override {
-    return {std::atan(Speed(t) * Psi(t, 1) / kG0) + s_.roll_amp * std::sin(s_.roll_w * t),
+    return {std::atan(Speed(t) * Psi(t, 1) / kStandardGravity_mps2) + s_.roll_amp * std::sin(s_.roll_w * t),
             Gamma(t, 0) + 0.05 + 0.02 * std::sin(0.9 * t), Psi(t, 0) + 0.03 * std::sin(0.7 * t)};
   }
-  Eigen::Vector3d EulerRate_rad_s(double t) const override {
-    const double x = Speed(t) * Psi(t, 1) / kG0;
-    const double dx = (s_.v1 * Psi(t, 1) + Speed(t) * Psi(t, 2)) / kG0;
+  Eigen::Vector3d EulerRate_radps(double t) const override {
+    const double x = Speed(t) * Psi(t, 1) / kStandardGravity_mps2;
+    const double dx = (s_.v1 * Psi(t, 1) + Speed(t) * Psi(t, 2)) / kStandardGravity_mps2;
     return {dx / (1.0 + x * x) + s_.roll_amp * s_.roll_w * std::cos(s_.roll_w * t),
             Gamma(t, 1) + 0.018 * std::cos(0.9 * t), Psi(t, 1) + 0.021 * std::cos(0.7 * t)};
   }
@@ -64,7 +65,6 @@ class Flight : public sim::AnalyticTrajectory {
   }
 
  private:
-  static constexpr double kG0 = 9.80665;
   double Speed(double t) const { return s_.v0 + s_.v1 * t; }
   // n-th derivative (0, 1, 2) of psi and gamma.
   double Psi(double t, int n) const {
@@ -94,7 +94,7 @@ const FlightShape kSlow{15.0, 0.2, -1.0, 0.1, 0.2, 0.5, 0.05, 0.3, 0.1, 0.8};
 class Static : public sim::AnalyticTrajectory {
  public:
   Eigen::Vector3d Euler_rad(double) const override { return {0.02, -0.01, 1.0}; }
-  Eigen::Vector3d EulerRate_rad_s(double) const override { return Eigen::Vector3d::Zero(); }
+  Eigen::Vector3d EulerRate_radps(double) const override { return Eigen::Vector3d::Zero(); }
   Eigen::Vector3d Velocity_n_mps(double) const override { return Eigen::Vector3d::Zero(); }
   Eigen::Vector3d Acceleration_n_mps2(double) const override { return Eigen::Vector3d::Zero(); }
 };

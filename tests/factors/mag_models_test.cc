@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "solvers/linearize.h"
 #include "tests/factors/tangent_jacobian_check.h"
@@ -29,7 +30,6 @@ namespace {
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
 const AttitudeManifold kAttitudeManifold;
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -86,7 +86,7 @@ TEST(MagVector, RejectsBadSigma) {
 }
 
 TEST(MagHeading, ZeroForTrueAttitudeAndPlusDForHeadingTooLarge) {
-  const double declination = 3.0 * kDeg, sigma = 0.02;
+  const double declination = 3.0 * kDegToRad, sigma = 0.02;
   const Eigen::Vector3d m_n = Field(declination);
   for (const Eigen::Vector3d& euler : {Eigen::Vector3d(0.0, 0.0, 0.7), Eigen::Vector3d(0.3, -0.25, -2.0),
                                        Eigen::Vector3d(-0.1, 0.4, 3.1)}) {
@@ -106,15 +106,15 @@ TEST(MagHeading, ZeroForTrueAttitudeAndPlusDForHeadingTooLarge) {
 TEST(MagHeading, WrapsAcrossPlusMinusPi) {
   // Magnetic north at D = 170 deg; estimated heading 20 deg too large: the raw difference
   // of the azimuths is 190 - 360 - 170 = -340 deg, wrapped +20 deg.
-  const double declination = 170.0 * kDeg, sigma = 0.1;
+  const double declination = 170.0 * kDegToRad, sigma = 0.1;
   const Eigen::Vector3d m_n = Field(declination);
   const Eigen::Quaterniond q = QuatFromEuler(0.0, 0.0, 0.5);
   const std::unique_ptr<ceres::CostFunction> f(
       MagHeading::Create(DcmFromQuat(q).transpose() * m_n, declination, sigma, 20.0));
-  const Eigen::Quaterniond q_est = QuatFromEuler(0.0, 0.0, 0.5 + 20.0 * kDeg);
-  EXPECT_NEAR(Eval1(*f, q_est) * sigma, 20.0 * kDeg, 1e-12);
-  const Eigen::Quaterniond q_est2 = QuatFromEuler(0.0, 0.0, 0.5 - 20.0 * kDeg);
-  EXPECT_NEAR(Eval1(*f, q_est2) * sigma, -20.0 * kDeg, 1e-12);
+  const Eigen::Quaterniond q_est = QuatFromEuler(0.0, 0.0, 0.5 + 20.0 * kDegToRad);
+  EXPECT_NEAR(Eval1(*f, q_est) * sigma, 20.0 * kDegToRad, 1e-12);
+  const Eigen::Quaterniond q_est2 = QuatFromEuler(0.0, 0.0, 0.5 - 20.0 * kDegToRad);
+  EXPECT_NEAR(Eval1(*f, q_est2) * sigma, -20.0 * kDegToRad, 1e-12);
 }
 
 TEST(MagHeading, TangentJacobianMatchesCentralDifferences) {
@@ -196,7 +196,7 @@ TEST(MagHeading, RemoveDipNoiseLeavesNoInformationAboutTheFieldAxis) {
 }
 
 TEST(MagHeading2Axis, MatchesMagHeadingWhenLevel) {
-  const double declination = -7.0 * kDeg, sigma = 0.03;
+  const double declination = -7.0 * kDegToRad, sigma = 0.03;
   const Eigen::Vector3d m_n = Field(declination);
   for (const double yaw_true : {0.0, 1.2, -2.9, M_PI}) {
     const Eigen::Vector3d m_b = DcmFromQuat(QuatFromEuler(0.0, 0.0, yaw_true)).transpose() * m_n;

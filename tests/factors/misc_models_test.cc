@@ -20,6 +20,7 @@
 
 #include "core/earth.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/position_manifold.h"
 #include "solvers/linearize.h"
 #include "tests/factors/tangent_jacobian_check.h"
@@ -30,7 +31,6 @@ namespace {
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
 const PositionManifold kPositionManifold;
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -148,7 +148,7 @@ TEST(BiasProcess, RejectsBadParameters) {
 }
 
 TEST(PositionPrior, ResidualIsTheWhitenedNedOffset) {
-  const Eigen::Vector3d p0(52.0 * kDeg, 4.4 * kDeg, 12.0), sigma(2.0, 4.0, 8.0);
+  const Eigen::Vector3d p0(52.0 * kDegToRad, 4.4 * kDegToRad, 12.0), sigma(2.0, 4.0, 8.0);
   const std::unique_ptr<ceres::CostFunction> f(PositionPrior::Create(p0, sigma));
   EXPECT_EQ(Residual(*f, {{Std(p0), nullptr, 0.0}}).norm(), 0.0);
   // 1 m east of p0 (exact, through ECEF): (0, 1/4, 0) up to the chart's ~|d|^2/R ~ 2e-7 m.

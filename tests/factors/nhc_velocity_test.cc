@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "solvers/linearize.h"
 #include "tests/factors/tangent_jacobian_check.h"
@@ -24,7 +25,6 @@ namespace {
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
 const AttitudeManifold kAttitudeManifold;
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Central-difference steps and tolerance as in gnss_models_test.cc (the residual is linear
 // in v and smooth in the attitude; |r| <= ~300 here).
@@ -37,7 +37,7 @@ Eigen::Vector2d Eval(const ceres::CostFunction& f, const Eigen::Vector3d& v_n, c
 }
 
 TEST(NhcVelocity, ZeroForMotionAlongTheVehicleAxis) {
-  const Eigen::Quaterniond q = QuatFromEuler<double>(5 * kDeg, -3 * kDeg, 130 * kDeg);
+  const Eigen::Quaterniond q = QuatFromEuler<double>(5 * kDegToRad, -3 * kDegToRad, 130 * kDegToRad);
   const Eigen::Vector3d v_n = q * Eigen::Vector3d(12.0, 0.0, 0.0);
   const std::unique_ptr<ceres::CostFunction> f(
       NhcVelocity::Create(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, 0.3),
@@ -46,7 +46,7 @@ TEST(NhcVelocity, ZeroForMotionAlongTheVehicleAxis) {
 }
 
 TEST(NhcVelocity, LateralAndVerticalVelocityGiveTheirSigmas) {
-  const Eigen::Quaterniond q = QuatFromEuler<double>(0.0, 0.0, 40 * kDeg);
+  const Eigen::Quaterniond q = QuatFromEuler<double>(0.0, 0.0, 40 * kDegToRad);
   const Eigen::Vector3d v_b(10.0, 0.3, -0.4);
   const std::unique_ptr<ceres::CostFunction> f(
       NhcVelocity::Create(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.1, 0.2));
@@ -58,8 +58,8 @@ TEST(NhcVelocity, LateralAndVerticalVelocityGiveTheirSigmas) {
 TEST(NhcVelocity, LeverArmAndMountingEnterAsInTheModel) {
   // The IMU yawed 90 deg in the vehicle (its x axis points to the vehicle's right): the
   // vehicle moves along its own x, which is the body's -y.
-  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(0.0, 0.0, 90 * kDeg);
-  const Eigen::Quaterniond q = QuatFromEuler<double>(0.0, 0.0, 10 * kDeg);
+  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(0.0, 0.0, 90 * kDegToRad);
+  const Eigen::Quaterniond q = QuatFromEuler<double>(0.0, 0.0, 10 * kDegToRad);
   const Eigen::Vector3d lever_b(0.0, 1.5, 0.0), omega_b(0.0, 0.0, 0.2);
   // Body velocity such that the reference point moves along the vehicle x only.
   const Eigen::Vector3d v_ref_b = R_v_b.transpose() * Eigen::Vector3d(8.0, 0.0, 0.0);
@@ -73,7 +73,7 @@ TEST(NhcVelocity, LeverArmAndMountingEnterAsInTheModel) {
 }
 
 TEST(NhcVelocity, TangentJacobiansMatchCentralDifferences) {
-  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(1 * kDeg, -2 * kDeg, 3 * kDeg);
+  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(1 * kDegToRad, -2 * kDegToRad, 3 * kDegToRad);
   const Eigen::Vector3d lever_b(-1.2, 0.1, 0.4), omega_b(0.05, -0.02, 0.3);
   for (const State& s : States()) {
     SCOPED_TRACE(s.name);

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "solvers/linearize.h"
 #include "tests/factors/tangent_jacobian_check.h"
@@ -23,7 +24,6 @@ namespace {
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
 const AttitudeManifold kAttitudeManifold;
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Steps and tolerance as in gnss_models_test.cc; the residual is bilinear in (v, s).
 constexpr double kAttStep = 1e-6, kVelStep = 1e-3, kScaleStep = 1e-4;
@@ -35,8 +35,8 @@ double Eval(const ceres::CostFunction& f, const Eigen::Vector3d& v_n, const Eige
 }
 
 TEST(OdometerSpeed, ZeroForTheScaledForwardSpeedOfTheReferencePoint) {
-  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(0.0, 1 * kDeg, -2 * kDeg);
-  const Eigen::Quaterniond q = QuatFromEuler<double>(3 * kDeg, -4 * kDeg, 75 * kDeg);
+  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(0.0, 1 * kDegToRad, -2 * kDegToRad);
+  const Eigen::Quaterniond q = QuatFromEuler<double>(3 * kDegToRad, -4 * kDegToRad, 75 * kDegToRad);
   const Eigen::Vector3d lever_b(-1.4, 0.2, 0.5), omega_b(0.01, -0.02, 0.25);
   const Eigen::Vector3d v_n(8.0, 6.0, -0.3);
   const double s = 0.004;
@@ -51,7 +51,7 @@ TEST(OdometerSpeed, ZeroForTheScaledForwardSpeedOfTheReferencePoint) {
 }
 
 TEST(OdometerSpeed, TangentJacobiansMatchCentralDifferences) {
-  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(-1 * kDeg, 2 * kDeg, 1.5 * kDeg);
+  const Eigen::Matrix3d R_v_b = DcmFromEuler<double>(-1 * kDegToRad, 2 * kDegToRad, 1.5 * kDegToRad);
   const Eigen::Vector3d lever_b(-1.2, 0.1, 0.4), omega_b(0.05, -0.02, 0.3);
   for (const State& st : States()) {
     SCOPED_TRACE(st.name);

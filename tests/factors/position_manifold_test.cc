@@ -14,12 +14,12 @@
 #include <gtest/gtest.h>
 
 #include "core/earth.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
 
 using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-constexpr double kDeg = M_PI / 180.0;
 
 struct Case {
   std::string name;
@@ -42,13 +42,13 @@ std::vector<Case> Cases() {
   std::vector<Case> cases;
   const Eigen::Vector3d equator(0.0, 0.3, 50.0);
   cases.push_back({"equator", equator, ned(100.0), plus(equator, ned(5000.0))});
-  const Eigen::Vector3d north60(60.0 * kDeg, -2.0, 200.0);
+  const Eigen::Vector3d north60(60.0 * kDegToRad, -2.0, 200.0);
   cases.push_back({"60N", north60, ned(100.0), plus(north60, ned(5000.0))});
-  const Eigen::Vector3d high(-35.0 * kDeg, 2.5, 20000.0);
+  const Eigen::Vector3d high(-35.0 * kDegToRad, 2.5, 20000.0);
   cases.push_back({"high_altitude", high, ned(100.0), plus(high, ned(5000.0))});
   // y on the other side of the date line: Minus must take the short way round.
-  const Eigen::Vector3d dateline(10.0 * kDeg, M_PI - 1e-6, 10.0);
-  cases.push_back({"date_line", dateline, ned(100.0), Eigen::Vector3d(10.0 * kDeg, -M_PI + 1e-6, 30.0)});
+  const Eigen::Vector3d dateline(10.0 * kDegToRad, M_PI - 1e-6, 10.0);
+  cases.push_back({"date_line", dateline, ned(100.0), Eigen::Vector3d(10.0 * kDegToRad, -M_PI + 1e-6, 30.0)});
   return cases;
 }
 

@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "solvers/linearize.h"
 
 namespace navtwin::tangent_check {
@@ -109,7 +110,7 @@ inline std::vector<State> States() {
   states.push_back({"zero", Eigen::Vector3d::Zero(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero()});
   states.push_back({"tiny", Eigen::Vector3d(1e-9, -1e-9, 1e-9), QuatFromRotVec<double>(Eigen::Vector3d(1e-9, -2e-9, 3e-9)),
                     Eigen::Vector3d(1e-9, 2e-9, -1e-9)});
-  const Eigen::Vector3d pos(80.0 * M_PI / 180.0 * u(rng), M_PI * u(rng), 2500.0 + 2500.0 * u(rng));
+  const Eigen::Vector3d pos(80.0 * kDegToRad * u(rng), M_PI * u(rng), 2500.0 + 2500.0 * u(rng));
   const Eigen::Vector3d phi = 3.0 * std::abs(u(rng)) * random3().normalized();
   states.push_back({"random", pos, QuatFromRotVec<double>(phi), 30.0 * random3()});
   return states;

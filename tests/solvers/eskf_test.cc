@@ -1,4 +1,5 @@
 #include "solvers/eskf.h"
+#include "core/units.h"
 
 #include <cmath>
 #include <limits>
@@ -15,14 +16,13 @@ namespace {
 // degrees of freedom), independent of the incomplete-gamma code under test. Returned as
 // the upper tail Q = 1 - P so that p = 0.9999 keeps its relative accuracy.
 double ChiSquareUpperTail(double x, int dof) {
-  const double pi = 3.14159265358979323846;
   switch (dof) {
     case 1:
       return std::erfc(std::sqrt(0.5 * x));
     case 2:
       return std::exp(-0.5 * x);
     case 3:
-      return std::erfc(std::sqrt(0.5 * x)) + std::sqrt(2.0 * x / pi) * std::exp(-0.5 * x);
+      return std::erfc(std::sqrt(0.5 * x)) + std::sqrt(2.0 * x / kPi) * std::exp(-0.5 * x);
     case 6:
       return std::exp(-0.5 * x) * (1.0 + 0.5 * x + x * x / 8.0);
   }

@@ -14,6 +14,7 @@
 
 #include "core/earth.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "factors/attitude_manifold.h"
 #include "factors/baro_height.h"
 #include "factors/gnss_position.h"
@@ -24,13 +25,12 @@ namespace navtwin {
 namespace {
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-constexpr double kDeg = M_PI / 180.0;
 
 const PositionManifold kPositionManifold;
 const AttitudeManifold kAttitudeManifold;
 
 struct Point {
-  Eigen::Vector3d pos{47.0 * kDeg, 8.5 * kDeg, 430.0};
+  Eigen::Vector3d pos{47.0 * kDegToRad, 8.5 * kDegToRad, 430.0};
   Eigen::Vector4d q = QuatFromEuler(0.1, -0.05, 2.0).coeffs();
 };
 

@@ -158,8 +158,7 @@ class MagSource : public AidingSource {
 }  // namespace
 
 Eigen::Vector3d CalibrateMag(const Eigen::Vector3d& m_raw_uT, const MagConfig& mag) {
-  const Eigen::Matrix3d I_plus_S = Eigen::Matrix3d::Identity() + mag.soft_iron;
-  return I_plus_S.partialPivLu().solve(m_raw_uT - mag.hard_iron_uT);
+  return mag.iron.Remove(m_raw_uT);
 }
 
 std::unique_ptr<AidingSource> MakeMagSource(const std::vector<MagSample>& samples, const MagConfig& config) {

@@ -10,12 +10,14 @@
 
 #include <Eigen/Core>
 
+#include "core/mag_iron_model.h"
 #include "core/types.h"
+#include "core/units.h"
 #include "problems/ins/aiding.h"
 
 namespace navtwin::ins {
 
-/// Magnetometer use. Calibration (hard iron h, soft iron S) follows the simulator's model
+/// Magnetometer use. The iron (hard iron h, soft iron S) is core/mag_iron_model.h's:
 /// m_b = (I + S) R_b_n m_n + h; measurements are corrected as (I + S)^-1 (m - h).
 struct MagConfig {
   enum class Mode {
@@ -27,11 +29,10 @@ struct MagConfig {
   Mode mode = Mode::kOff;
   Eigen::Vector3d field_ned_uT = Eigen::Vector3d::Zero();  ///< for kVector
   double declination_rad = 0.0;                            ///< east of true north
-  Eigen::Vector3d hard_iron_uT = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d soft_iron = Eigen::Matrix3d::Zero();
+  MagIronModel iron;
   double noise_uT = 0.5;            ///< per axis, kVector
   double heading_std_rad = 0.035;   ///< kHeading, kHeading2Axis
-  double max_tilt_rad = 2.0 * 3.14159265358979323846 / 180.0;
+  double max_tilt_rad = 2.0 * kDegToRad;
   double min_interval_s = 0.0;      ///< use at most one sample per this interval (0: all)
 };
 

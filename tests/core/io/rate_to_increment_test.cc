@@ -41,7 +41,7 @@ TEST(RateToIncrementTest, TrapezoidIsExactForRatesLinearInTime) {
   for (int k = 0; k < 50; ++k) {
     RateSample s;
     s.t_s = t;
-    s.gyro_rad_s = a + b * t;
+    s.gyro_radps = a + b * t;
     s.acc_mps2 = c + d * t;
     if (k == 0) {
       ASSERT_FALSE(r.Add(s, &out));

@@ -26,7 +26,7 @@ class Wobble : public AnalyticTrajectory {
   Eigen::Vector3d Euler_rad(double t) const override {
     return {0.5 * std::sin(kW1 * t), 0.3 * std::sin(kW2 * t), 1.0 + 0.4 * std::sin(kW3 * t)};
   }
-  Eigen::Vector3d EulerRate_rad_s(double t) const override {
+  Eigen::Vector3d EulerRate_radps(double t) const override {
     return {0.5 * kW1 * std::cos(kW1 * t), 0.3 * kW2 * std::cos(kW2 * t),
             0.4 * kW3 * std::cos(kW3 * t)};
   }
@@ -65,7 +65,7 @@ std::vector<TruthSample> StaticStream(double rate_hz, long count,
     s.state.lon_rad = kStart.lon_rad;
     s.state.h_m = kStart.h_m;
     s.state.q_n_b = QuatFromEuler(euler.x(), euler.y(), euler.z());
-    s.omega_ib_b_rad_s = s.state.q_n_b.conjugate() * wgs84::EarthRateNed(kStart.lat_rad);
+    s.omega_ib_b_radps = s.state.q_n_b.conjugate() * wgs84::EarthRateNed(kStart.lat_rad);
   }
   return out;
 }
@@ -112,7 +112,7 @@ TEST(AidingTest, InterpolatedTruthMatchesTheTruthBetweenSamples) {
   // rate) and compare at the nine samples in between.
   Wobble wobble;
   const std::vector<TruthSample> fine = TruthStream(wobble, 1000.0, 20.0);
-  double pos_m = 0, vel_mps = 0, att_rad = 0, omega_rad_s = 0;
+  double pos_m = 0, vel_mps = 0, att_rad = 0, omega_radps = 0;
   for (std::size_t k = 0; k + 10 < fine.size(); k += 10) {
     for (std::size_t j = 1; j < 10; ++j) {
       const TruthSample& f = fine[k + j];
@@ -122,7 +122,7 @@ TEST(AidingTest, InterpolatedTruthMatchesTheTruthBetweenSamples) {
                                   .norm());
       vel_mps = std::max(vel_mps, (x.state.v_n_mps - f.state.v_n_mps).norm());
       att_rad = std::max(att_rad, AttitudeError(f.state.q_n_b, x.state.q_n_b).norm());
-      omega_rad_s = std::max(omega_rad_s, (x.omega_ib_b_rad_s - f.omega_ib_b_rad_s).norm());
+      omega_radps = std::max(omega_radps, (x.omega_ib_b_radps - f.omega_ib_b_radps).norm());
     }
   }
   // Cubic Hermite over h = 10 ms: error ~ h^4/384 |y^(4)| (|d3 v/dt3| ~ 2 (2 pi)^3 gives
@@ -132,7 +132,7 @@ TEST(AidingTest, InterpolatedTruthMatchesTheTruthBetweenSamples) {
   EXPECT_LT(pos_m, 1e-7);
   EXPECT_LT(vel_mps, 1e-6);
   EXPECT_LT(att_rad, 1e-7);
-  EXPECT_LT(omega_rad_s, 5e-5);
+  EXPECT_LT(omega_radps, 5e-5);
 }
 
 TEST(AidingTest, InterpolationEndsAreTheSamplesAndBadTimesThrow) {
@@ -185,7 +185,7 @@ TEST(AidingTest, LeverArmMovesTheAntennaExactly) {
   // east at 0.5 m/s. Its NED differs from the IMU's by a rotation about east, which leaves
   // an east velocity unchanged: exact to rounding.
   TruthSample turning = StaticStream(1.0, 1)[0];
-  turning.omega_ib_b_rad_s += Eigen::Vector3d(0.0, 0.0, 0.5);
+  turning.omega_ib_b_radps += Eigen::Vector3d(0.0, 0.0, 0.5);
   EXPECT_LT((AntennaTruth(turning, arm).v_n_mps - Eigen::Vector3d(0, 0.5, 0)).norm(), 1e-12);
 }
 
@@ -439,7 +439,7 @@ TEST(AidingTest, OdometerReadsTheForwardSpeedOfItsReferencePoint) {
     const auto at = std::find_if(truth.begin(), truth.end(), [&](const TruthSample& t) { return std::abs(t.t_s - s.t_s) < 1e-9; });
     ASSERT_NE(at, truth.end());
     const Eigen::Vector3d v_b =
-        at->state.q_n_b.conjugate() * at->state.v_n_mps + at->omega_ib_b_rad_s.cross(c.lever_arm_b_m);
+        at->state.q_n_b.conjugate() * at->state.v_n_mps + at->omega_ib_b_radps.cross(c.lever_arm_b_m);
     EXPECT_NEAR(s.speed_mps, v_b.x(), 1e-9);
   }
   EXPECT_EQ(scaled.scale_factor(), 0.01);

@@ -221,11 +221,11 @@ AliasRun RunAliasDemonstration(double tone_hz, double seconds) {
   VibrationToneConfig tone;
   tone.axes = {{true, false, false}};
   tone.frequency_hz = {tone_hz, tone_hz};
-  tone.linear_g = 1.0;
+  tone.linear_mps2 = 1.0 * kStandardGravity_mps2;
   tone.random_amplitude = false;
   VibrationToneConfig motion = tone;
   motion.frequency_hz = {2.0, 2.0};
-  motion.linear_g = 0.1;
+  motion.linear_mps2 = 0.1 * kStandardGravity_mps2;
   config.tones = {tone, motion};
   const VibrationModel vibration(config, Rng(1), false);
 

@@ -57,7 +57,7 @@ double DerivativeMismatch(const AnalyticTrajectory& tr, double t0, double t1, do
   for (double t = t0; t <= t1; t += step) {
     const Eigen::Vector3d de = (tr.Euler_rad(t + h) - tr.Euler_rad(t - h)) / (2 * h);
     const Eigen::Vector3d dv = (tr.Velocity_n_mps(t + h) - tr.Velocity_n_mps(t - h)) / (2 * h);
-    worst = std::max({worst, (de - tr.EulerRate_rad_s(t)).cwiseAbs().maxCoeff(),
+    worst = std::max({worst, (de - tr.EulerRate_radps(t)).cwiseAbs().maxCoeff(),
                       (dv - tr.Acceleration_n_mps2(t)).cwiseAbs().maxCoeff()});
   }
   return worst;
@@ -70,7 +70,7 @@ double PointMismatch(const AnalyticTrajectory& tr, double t0, double t1, double 
   for (double t = t0; t <= t1; t += step) {
     const TrajectoryPoint p = tr.PointAt(t);
     worst = std::max({worst, (p.euler_rad - tr.Euler_rad(t)).cwiseAbs().maxCoeff(),
-                      (p.euler_rate_rad_s - tr.EulerRate_rad_s(t)).cwiseAbs().maxCoeff(),
+                      (p.euler_rate_radps - tr.EulerRate_radps(t)).cwiseAbs().maxCoeff(),
                       (p.v_n_mps - tr.Velocity_n_mps(t)).cwiseAbs().maxCoeff(),
                       (p.a_n_mps2 - tr.Acceleration_n_mps2(t)).cwiseAbs().maxCoeff()});
   }
@@ -109,7 +109,7 @@ TEST(CalibrationRigTest, TableScheduleAndStaticIntervals) {
   for (const StaticInterval& i : s) {
     for (const double t : {i.start_s, 0.5 * (i.start_s + i.end_s), i.end_s - 1e-9}) {
       EXPECT_EQ(rig.Euler_rad(t), i.euler_rad) << t;
-      EXPECT_EQ(rig.EulerRate_rad_s(t), Eigen::Vector3d::Zero()) << t;
+      EXPECT_EQ(rig.EulerRate_radps(t), Eigen::Vector3d::Zero()) << t;
     }
   }
   // After the schedule the last attitude is held.
@@ -121,13 +121,13 @@ TEST(CalibrationRigTest, TableRatesAreTheDerivativesAndContinuous) {
   EXPECT_LT(DerivativeMismatch(rig, 1e-4, 90.0, 0.0071), 1e-7);  // measured 5e-10
   EXPECT_EQ(PointMismatch(rig, 0.0, 90.0, 0.0071), 0.0);
   // The constant rate of the yaw spin (starts at 5 + 5 * 9 = 50 s, 1 s ramp).
-  EXPECT_NEAR(rig.EulerRate_rad_s(57.0).z() * kRadToDeg, 30.0, 1e-12);
+  EXPECT_NEAR(rig.EulerRate_radps(57.0).z() * kRadToDeg, 30.0, 1e-12);
   // Angular acceleration continuous (C2) at every segment boundary: one-sided differences
   // of the rate agree to O(h |jerk|) (jerk < 300 rad/s^3 on the 0.5 s ramps).
   constexpr double h = 1e-6;
   for (const double tb : {5.0, 9.0, 50.0, 51.0, 62.0, 63.0, 68.0, 68.5, 75.5, 76.0, 79.0, 83.0}) {
-    const Eigen::Vector3d before = (rig.EulerRate_rad_s(tb) - rig.EulerRate_rad_s(tb - h)) / h;
-    const Eigen::Vector3d after = (rig.EulerRate_rad_s(tb + h) - rig.EulerRate_rad_s(tb)) / h;
+    const Eigen::Vector3d before = (rig.EulerRate_radps(tb) - rig.EulerRate_radps(tb - h)) / h;
+    const Eigen::Vector3d after = (rig.EulerRate_radps(tb + h) - rig.EulerRate_radps(tb)) / h;
     EXPECT_LT((after - before).cwiseAbs().maxCoeff(), 1e-3) << tb;
   }
 }
@@ -152,11 +152,11 @@ TEST(CalibrationRigTest, PendulumAngleFollowsTheOde) {
   EXPECT_DOUBLE_EQ(rig.c2_per_s2(), 9.80665 / 0.8);
   EXPECT_EQ(rig.c1_per_s(), 0.05);
   EXPECT_NEAR(rig.Angle_rad(0.0), 40.0 * kDegToRad, 1e-15);
-  EXPECT_EQ(rig.AngleRate_rad_s(0.0), 0.0);
+  EXPECT_EQ(rig.AngleRate_radps(0.0), 0.0);
   double residual = 0.0;
   for (double t = 0.0; t < 120.0; t += 0.00737) {  // mostly between the 10 ms nodes
     residual = std::max(residual, std::fabs(rig.AngleAcceleration_rad_s2(t) +
-                                            rig.c1_per_s() * rig.AngleRate_rad_s(t) +
+                                            rig.c1_per_s() * rig.AngleRate_radps(t) +
                                             rig.c2_per_s2() * std::sin(rig.Angle_rad(t))));
   }
   // The quintic Hermite's theta'' between the 10 ms nodes: O(H^4 |theta^(6)|) ~ 1e-8 for
@@ -170,7 +170,7 @@ TEST(CalibrationRigTest, UndampedPendulumKeepsItsEnergy) {
   c.initial_angle_rad = 1.2;
   PendulumRig rig(c);
   const auto energy = [&](double t) {
-    return 0.5 * std::pow(rig.AngleRate_rad_s(t), 2) - rig.c2_per_s2() * std::cos(rig.Angle_rad(t));
+    return 0.5 * std::pow(rig.AngleRate_radps(t), 2) - rig.c2_per_s2() * std::cos(rig.Angle_rad(t));
   };
   const double e0 = energy(0.0);
   double drift = 0.0;
@@ -227,13 +227,13 @@ TEST(CalibrationRigTest, PendulumMountingsGiveTheBobAttitudeAndRates) {
                                                   QuatFromDcm(Eigen::Matrix3d(R_n_p * m.R_p_b)))
                                         .norm());
       // Body rate over NED: theta' about the pivot axis (east) in IMU axes.
-      const Eigen::Vector3d de = rig.EulerRate_rad_s(t);
+      const Eigen::Vector3d de = rig.EulerRate_radps(t);
       const double sr = std::sin(e.x()), cr = std::cos(e.x()), sp = std::sin(e.y()),
                    cp = std::cos(e.y());
       const Eigen::Vector3d omega_nb_b(de.x() - de.z() * sp, de.y() * cr + de.z() * sr * cp,
                                        -de.y() * sr + de.z() * cr * cp);
       rate =
-          std::max(rate, (omega_nb_b - rig.AngleRate_rad_s(t) * m.R_p_b.transpose().col(1)).norm());
+          std::max(rate, (omega_nb_b - rig.AngleRate_radps(t) * m.R_p_b.transpose().col(1)).norm());
       // The IMU moves on the circle L (sin theta, 0, cos theta) about the pivot.
       const auto bob = [&](double s) {
         const double th = rig.Angle_rad(s);

@@ -15,13 +15,11 @@
 #include "core/allan.h"
 #include "core/io/input_error.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 namespace {
 
-constexpr double kDegH = kDegToRad / 3600.0;   // rad/s per deg/h
-constexpr double kUg = 9.80665e-6;             // m/s^2 per ug
-constexpr double kArcsec = kDegToRad / 3600.0; // rad per arcsec
 
 InertialErrorConfig Parse(const std::string& yaml) {
   return ParseInertialErrorConfig(ParseYaml(yaml, "errors.yaml"));
@@ -100,26 +98,26 @@ temperature_profile: {reference_degC: 20, initial_degC: 10, final_degC: 40, time
 )");
   // Conversions are exact products, so 1e-15 relative covers their rounding.
   const auto near = [](double a, double b) { EXPECT_NEAR(a, b, 1e-15 * std::abs(b)); };
-  near(c.gyro.bias.sigma, 1.5 * kDegH);
+  near(c.gyro.bias.sigma, 1.5 * kDegPerHour_radps);
   EXPECT_FALSE(c.gyro.bias.fixed.has_value());
-  near(c.gyro.bias_instability, 0.5 * kDegH);
+  near(c.gyro.bias_instability, 0.5 * kDegPerHour_radps);
   near(c.gyro.correlation_time_s, 100.0);
-  near(c.gyro.random_walk, 0.1 * kDegH / 60.0);  // (deg/h)/sqrt(h) -> (rad/s)/sqrt(s)
+  near(c.gyro.random_walk, 0.1 * kDegPerHour_radps / 60.0);  // (deg/h)/sqrt(h) -> (rad/s)/sqrt(s)
   near(c.gyro.white_noise, 0.05 * kDegToRad / 60.0);  // deg/sqrt(h) -> rad/sqrt(s)
   near(c.gyro.scale_factor.sigma, 100e-6);
-  near(c.gyro.misalignment.sigma, 5.0 * kArcsec);
+  near(c.gyro.misalignment.sigma, 5.0 * kArcsec_rad);
   near(c.gyro.quantum, 1e-6);
-  near(c.gyro.bias_per_degC.sigma, 0.01 * kDegH);
-  near((*c.gyro.bias_per_degC2.fixed)[2], 3.0 * kDegH);
+  near(c.gyro.bias_per_degC.sigma, 0.01 * kDegPerHour_radps);
+  near((*c.gyro.bias_per_degC2.fixed)[2], 3.0 * kDegPerHour_radps);
   near(c.gyro.scale_factor_per_degC.sigma, 2e-6);
   near((*c.gyro.scale_factor_per_degC2.fixed)[1], 5e-6);
-  near((*c.accel.bias.fixed)[1], -50.0 * kUg);
+  near((*c.accel.bias.fixed)[1], -50.0 * kMicroG_mps2);
   near(c.accel.white_noise, 0.06 / 60.0);  // m/s/sqrt(h) -> m/s/sqrt(s)
-  near(c.accel.random_walk, 3.0 * kUg / 60.0);
+  near(c.accel.random_walk, 3.0 * kMicroG_mps2 / 60.0);
   near((*c.accel.scale_factor.fixed)[2], 30e-6);
-  near((*c.accel.misalignment.fixed)(1, 0), 3.0 * kArcsec);
+  near((*c.accel.misalignment.fixed)(1, 0), 3.0 * kArcsec_rad);
   near(c.accel.quantum, 1e-4);
-  near((*c.g_sensitivity.fixed)(2, 1), 8.0 * kDegH / 9.80665);
+  near((*c.g_sensitivity.fixed)(2, 1), 8.0 * kDegPerHour_radps / 9.80665);
   near(c.temperature.reference_degC, 20.0);
   near(c.temperature.At(0.0), 10.0);
   near(c.temperature.At(300.0), 40.0 - 30.0 / std::exp(1.0));
@@ -458,18 +456,18 @@ TEST(InertialErrorModel, ErrorsYamlListsTheDrawnValuesInTheirUnits) {
   // The emitter writes 17 significant digits; 1e-12 relative is plenty.
   const auto near = [](double a, double b) { EXPECT_NEAR(a, b, 1e-12 * std::abs(b)); };
   EXPECT_FALSE(y["perfect"].as<bool>());
-  near(y["gyro"]["bias_deg_h"][1].as<double>(), m.gyro().drawn().bias[1] / kDegH);
-  near(y["gyro"]["misalignment_arcsec"][0][2].as<double>(), m.gyro().drawn().misalignment(0, 2) / kArcsec);
+  near(y["gyro"]["bias_deg_h"][1].as<double>(), m.gyro().drawn().bias[1] / kDegPerHour_radps);
+  near(y["gyro"]["misalignment_arcsec"][0][2].as<double>(), m.gyro().drawn().misalignment(0, 2) / kArcsec_rad);
   EXPECT_EQ(y["gyro"]["misalignment_arcsec"][1][1].as<double>(), 0.0);
   near(y["gyro"]["scale_factor_ppm"][2].as<double>(), m.gyro().drawn().scale_factor[2] / 1e-6);
   near(y["gyro"]["arw_deg_sqrt_h"].as<double>(), 0.2);
   near(y["gyro"]["bias_instability_initial_deg_h"][0].as<double>(),
-       m.gyro().drawn().bias_instability_initial[0] / kDegH);
-  near(y["gyro"]["temperature"]["bias_deg_h_per_degC2"][0].as<double>(), m.gyro().drawn().bias_per_degC2[0] / kDegH);
-  near(y["accel"]["bias_ug"][0].as<double>(), m.accel().drawn().bias[0] / kUg);
+       m.gyro().drawn().bias_instability_initial[0] / kDegPerHour_radps);
+  near(y["gyro"]["temperature"]["bias_deg_h_per_degC2"][0].as<double>(), m.gyro().drawn().bias_per_degC2[0] / kDegPerHour_radps);
+  near(y["accel"]["bias_ug"][0].as<double>(), m.accel().drawn().bias[0] / kMicroG_mps2);
   near(y["accel"]["vrw_m_s_sqrt_h"].as<double>(), 0.05);
   near(y["accel"]["acceleration_random_walk_ug_sqrt_h"].as<double>(), 5.0);
-  near(y["g_sensitivity_deg_h_per_g"][2][1].as<double>(), m.g_sensitivity()(2, 1) / (kDegH / 9.80665));
+  near(y["g_sensitivity_deg_h_per_g"][2][1].as<double>(), m.g_sensitivity()(2, 1) / (kDegPerHour_radps / 9.80665));
   near(y["temperature_profile"]["final_degC"].as<double>(), 40.0);
 }
 

@@ -12,11 +12,11 @@
 #include "core/io/input_error.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
+#include "core/units.h"
 
 namespace navtwin::sim {
 namespace {
 
-constexpr double kG0_mps2 = 9.80665;  // the bank's gravity (core/sim/segments.cc)
 
 // Every segment kind, ~10 min (590 s). Speeds: 0 -> 30 -> 48 -> 6 -> 0 m/s; heading
 // 90 -> 180 (hover) -> 270 (turn) -> 150 (turn at 6 deg/s) -> -130 deg (hover).
@@ -94,7 +94,7 @@ TEST(SegmentTrajectory, AnalyticDerivativesMatchCentralDifferences) {
     const double tp = t + h, tm = t - h, step = tp - tm;
     const Eigen::Vector3d de = (traj.Euler_rad(tp) - traj.Euler_rad(tm)) / step;
     const Eigen::Vector3d dv = (traj.Velocity_n_mps(tp) - traj.Velocity_n_mps(tm)) / step;
-    max_euler_err = std::max(max_euler_err, (de - traj.EulerRate_rad_s(t)).norm());
+    max_euler_err = std::max(max_euler_err, (de - traj.EulerRate_radps(t)).norm());
     max_accel_err = std::max(max_accel_err, (dv - traj.Acceleration_n_mps2(t)).norm());
   }
   // Every channel has continuous third derivatives, so the central difference errs by
@@ -119,7 +119,7 @@ TEST(SegmentTrajectory, MotionIsContinuousAtEveryKnot) {
       return ((f(k + h) - f(k)) / h - (f(k) - f(k - h)) / h).norm();
     };
     const auto euler = [&](double t) { return traj.Euler_rad(t); };
-    const auto rate = [&](double t) { return traj.EulerRate_rad_s(t); };
+    const auto rate = [&](double t) { return traj.EulerRate_radps(t); };
     const auto velocity = [&](double t) { return traj.Velocity_n_mps(t); };
     const auto accel = [&](double t) { return traj.Acceleration_n_mps2(t); };
     max_angle_jump = std::max(max_angle_jump, jump(euler));
@@ -159,7 +159,7 @@ TEST(SegmentTrajectory, SegmentsReachTheirTargets) {
   EXPECT_EQ(traj.Velocity_n_mps(15.0).norm(), 0.0);
   EXPECT_LT((traj.Euler_rad(15.0) - kDegToRad * Eigen::Vector3d(0, 2, 90)).norm(), tol);
   // hover: 5 deg/s after the 2 s ramp, 5 * (20 - 2) = 90 deg turned, still at rest.
-  EXPECT_NEAR(traj.EulerRate_rad_s(s[1] + 10.0).z() * kRadToDeg, 5.0, tol);
+  EXPECT_NEAR(traj.EulerRate_radps(s[1] + 10.0).z() * kRadToDeg, 5.0, tol);
   EXPECT_NEAR(heading_deg(s[2]), 180.0, tol);
   EXPECT_EQ(traj.Velocity_n_mps(s[1] + 10.0).norm(), 0.0);
   // accelerate to 30 m/s: constant 30 / (20 - 2) m/s^2 between the ramps.
@@ -167,8 +167,8 @@ TEST(SegmentTrajectory, SegmentsReachTheirTargets) {
   EXPECT_NEAR(traj.Acceleration_n_mps2(s[2] + 10.0).norm(), 30.0 / 18.0, tol);
   // turn of 90 deg over 30 s: rate 90 / 28 deg/s, bank atan(V psi' / g).
   const double turn_rate = 90.0 / 28.0 * kDegToRad;
-  EXPECT_NEAR(traj.EulerRate_rad_s(s[3] + 15.0).z(), turn_rate, tol);
-  EXPECT_NEAR(traj.Euler_rad(s[3] + 15.0).x(), std::atan(30.0 * turn_rate / kG0_mps2), tol);
+  EXPECT_NEAR(traj.EulerRate_radps(s[3] + 15.0).z(), turn_rate, tol);
+  EXPECT_NEAR(traj.Euler_rad(s[3] + 15.0).x(), std::atan(30.0 * turn_rate / kStandardGravity_mps2), tol);
   EXPECT_NEAR(heading_deg(s[4]), 270.0, tol);
   EXPECT_NEAR(traj.Euler_rad(s[4]).x(), 0.0, tol);  // wings level after the turn
   // climb at 5 m/s: the flight path asin(5/30) is reached within the 2 s transition.
@@ -177,9 +177,9 @@ TEST(SegmentTrajectory, SegmentsReachTheirTargets) {
   // cruise levels off.
   EXPECT_NEAR(traj.Velocity_n_mps(s[5] + 2.0).z(), 0.0, tol);
   // turn at 6 deg/s: the plateau rate, then straight after 20 + 2 s.
-  EXPECT_NEAR(traj.EulerRate_rad_s(s[6] + 10.0).z() * kRadToDeg, -6.0, tol);
+  EXPECT_NEAR(traj.EulerRate_radps(s[6] + 10.0).z() * kRadToDeg, -6.0, tol);
   EXPECT_NEAR(heading_deg(s[6] + 22.0), 150.0, tol);
-  EXPECT_EQ(traj.EulerRate_rad_s(s[6] + 30.0).z(), 0.0);
+  EXPECT_EQ(traj.EulerRate_radps(s[6] + 30.0).z(), 0.0);
   // S-turns: +20 deg at tau = 50 s (sin(2 pi 50 / 40) = 1), back to 150 deg at the end.
   EXPECT_NEAR(heading_deg(s[7] + 50.0), 170.0, tol);
   EXPECT_NEAR(heading_deg(s[8]), 150.0, tol);

@@ -19,13 +19,13 @@ VibrationConfig MixedConfig() {
   VibrationToneConfig rotor;
   rotor.axes = {{true, true, true}};
   rotor.frequency_hz = {22.0, 24.0};
-  rotor.linear_g = 1.0;
+  rotor.linear_mps2 = 1.0 * kStandardGravity_mps2;
   rotor.harmonic_gains = {1.0, 0.5};
   VibrationToneConfig angular;
   angular.axes = {{false, true, true}};
   angular.frequency_hz = {150.0, 210.0};
-  angular.linear_g = 0.2;
-  angular.angular_deg_s = 2.0;
+  angular.linear_mps2 = 0.2 * kStandardGravity_mps2;
+  angular.angular_radps = 2.0 * kDegToRad;
   angular.random_amplitude = false;
   angular.harmonic_gains = {1.0, 0.3};
   VibrationConfig config;
@@ -100,7 +100,7 @@ TEST(Vibration, DrawnValuesHaveTheConfiguredDistributions) {
   VibrationToneConfig rotor;
   rotor.axes = {{true, true, true}};
   rotor.frequency_hz = {22.0, 24.0};
-  rotor.linear_g = 1.0;
+  rotor.linear_mps2 = 1.0 * kStandardGravity_mps2;
   VibrationConfig config;
   config.tones = {rotor};
   std::vector<double> amplitudes_g, frequencies_hz, phases_rad;
@@ -145,8 +145,8 @@ TEST(Vibration, FixedAmplitudesAndHarmonics) {
   VibrationToneConfig group;
   group.axes = {{true, false, true}};
   group.frequency_hz = {100.0, 110.0};
-  group.linear_g = 0.5;
-  group.angular_deg_s = 3.0;
+  group.linear_mps2 = 0.5 * kStandardGravity_mps2;
+  group.angular_radps = 3.0 * kDegToRad;
   group.random_amplitude = false;
   group.harmonic_gains = {1.0, 1.0 / 2.0, 1.0 / 3.0};
   VibrationConfig config;
@@ -176,7 +176,7 @@ TEST(Vibration, PerfectAndEmptyConfigurationsGiveNoVibration) {
 
 TEST(Vibration, EachGroupAndKindDrawsFromItsOwnStream) {
   VibrationConfig linear_only = MixedConfig();
-  linear_only.tones[1].angular_deg_s = 0.0;
+  linear_only.tones[1].angular_radps = 0.0 * kDegToRad;
   VibrationConfig first_only = MixedConfig();
   first_only.tones.pop_back();
   const VibrationModel full(MixedConfig(), Rng(5), false);
@@ -209,7 +209,7 @@ TEST(Vibration, SeedZeroPlainAverageErrorMatchesThePublishedRms) {
   VibrationToneConfig rotor;
   rotor.axes = {{true, false, false}};
   rotor.frequency_hz = {22.0, 24.0};
-  rotor.linear_g = 1.0;
+  rotor.linear_mps2 = 1.0 * kStandardGravity_mps2;
   VibrationConfig config;
   config.tones = {rotor};
   double sum_sq = 0.0;
@@ -256,14 +256,14 @@ TEST(VibrationConfig, ParsesTheSchema) {
   const VibrationToneConfig& a = config.tones[0];
   EXPECT_TRUE(a.axes[0] && !a.axes[1] && !a.axes[2]);
   EXPECT_EQ(a.frequency_hz, Eigen::Vector2d(22.0, 24.0));
-  EXPECT_EQ(a.linear_g, 1.0);
-  EXPECT_EQ(a.angular_deg_s, 0.0);
+  EXPECT_EQ(a.linear_mps2, 1.0 * kStandardGravity_mps2);
+  EXPECT_EQ(a.angular_radps, 0.0);
   EXPECT_TRUE(a.random_amplitude);
   EXPECT_EQ(a.harmonic_gains, std::vector<double>{1.0});
   const VibrationToneConfig& b = config.tones[1];
   EXPECT_TRUE(!b.axes[0] && b.axes[1] && b.axes[2]);
   EXPECT_FALSE(b.random_amplitude);
-  EXPECT_EQ(b.angular_deg_s, 2.5);
+  EXPECT_EQ(b.angular_radps, 2.5 * kDegPerSecond_radps);
   EXPECT_EQ(b.harmonic_gains, (std::vector<double>{1.0, 0.5, 1.0 / 3.0}));
   EXPECT_EQ(config.tones[2].harmonic_gains, (std::vector<double>{1.0, 0.25}));
   EXPECT_TRUE(ParseVibrationConfig(VibrationNode("imu: {}\n")).tones.empty());

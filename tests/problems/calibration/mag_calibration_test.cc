@@ -24,14 +24,14 @@
 #include "core/io/open.h"
 #include "core/rotation.h"
 #include "core/sim/random.h"
+#include "core/units.h"
 #include "tests/test_data.h"
 
 namespace navtwin::calibration {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kField_uT = 50.0;
-constexpr double kInclination_rad = 57.0 * kDeg;
+constexpr double kInclination_rad = 57.0 * kDegToRad;
 
 /// The seed's field in NED (declination 0): B (cos I, 0, sin I).
 Eigen::Vector3d FieldNed() { return kField_uT * Eigen::Vector3d(std::cos(kInclination_rad), 0.0, std::sin(kInclination_rad)); }
@@ -186,12 +186,12 @@ TEST(FitEllipsoid, HeadingErrorBeforeAndAfter) {
   EllipsoidFitOptions options;
   options.field_uT = kField_uT;
   const MagCalibration c = FitEllipsoid(SphereSamples(iron, 1000, 0.3, rng), options);
-  const double declination = 8.0 * kDeg;
+  const double declination = 8.0 * kDegToRad;
   double ss_before = 0.0, ss_after = 0.0;
   const int n = 2000;
   for (int i = 0; i < n; ++i) {
-    const double roll = rng.Uniform(-60.0, 60.0) * kDeg, pitch = rng.Uniform(-60.0, 60.0) * kDeg;
-    const double yaw = rng.Uniform(-180.0, 180.0) * kDeg;
+    const double roll = rng.Uniform(-60.0, 60.0) * kDegToRad, pitch = rng.Uniform(-60.0, 60.0) * kDegToRad;
+    const double yaw = rng.Uniform(-180.0, 180.0) * kDegToRad;
     const Eigen::Vector3d m = Measure(iron, DcmFromEuler(roll, pitch, yaw), 0.3, rng);
     const double truth = WrapPi(yaw + declination);
     const double before = WrapPi(TiltCompensatedHeading(m, roll, pitch, declination) - truth);
@@ -199,7 +199,7 @@ TEST(FitEllipsoid, HeadingErrorBeforeAndAfter) {
     ss_before += before * before;
     ss_after += after * after;
   }
-  const double rms_before_deg = std::sqrt(ss_before / n) / kDeg, rms_after_deg = std::sqrt(ss_after / n) / kDeg;
+  const double rms_before_deg = std::sqrt(ss_before / n) / kDegToRad, rms_after_deg = std::sqrt(ss_after / n) / kDegToRad;
   std::cout << "[ellipsoid heading] RMS heading error before " << rms_before_deg << " deg, after " << rms_after_deg
             << " deg\n";
   EXPECT_GT(rms_before_deg, 10.0);  // 10-30 uT of hard iron against a 27 uT horizontal field
@@ -224,7 +224,7 @@ TEST(FitEllipsoid, OnePlaneIsACoverageError) {
   // patch of the sphere.
   std::vector<MagSample> cap(500);
   for (int i = 0; i < 500; ++i) {
-    cap[i].m_b_uT = Measure(iron, DcmFromEuler(rng.Uniform(-5.0, 5.0) * kDeg, rng.Uniform(-5.0, 5.0) * kDeg, 0.0),
+    cap[i].m_b_uT = Measure(iron, DcmFromEuler(rng.Uniform(-5.0, 5.0) * kDegToRad, rng.Uniform(-5.0, 5.0) * kDegToRad, 0.0),
                             0.3, rng);
   }
   EXPECT_THROW(FitEllipsoid(cap), std::runtime_error);
@@ -319,7 +319,7 @@ LevelTurn SimulateTurn(const Eigen::Matrix3d& M, const Eigen::Vector3d& h_uT, do
   LevelTurn turn;
   for (int i = 0; i < 1540; ++i) {
     const bool tilted = i >= 1440;
-    const double roll = tilted ? 10.0 * kDeg : 0.0, pitch = 0.0, yaw = WrapPi(0.5 * kDeg * i + 0.3);
+    const double roll = tilted ? 10.0 * kDegToRad : 0.0, pitch = 0.0, yaw = WrapPi(0.5 * kDegToRad * i + 0.3);
     MagSample s;
     s.t_s = 0.02 * i;
     s.m_b_uT = M * (DcmFromEuler(roll, pitch, yaw).transpose() * FieldNed()) + h_uT;
@@ -334,7 +334,7 @@ LevelTurn SimulateTurn(const Eigen::Matrix3d& M, const Eigen::Vector3d& h_uT, do
 TEST(FitBidirectional, RecoversHardIronAndTheSeedsPhaseOnALevelTurn) {
   sim::Rng rng(31);
   const double H = kField_uT * std::cos(kInclination_rad);  // 27.2 uT
-  const double phase = -15.32 * kDeg;                        // the seed's example
+  const double phase = -15.32 * kDegToRad;                        // the seed's example
   const Eigen::Vector3d h(18.0, -12.0, 0.0);
   const LevelTurn turn = SimulateTurn(TwoAxisIron(1.06, 0.93, phase), h, 0.2, rng);
   const MagCalibration c = FitBidirectional(turn.samples, turn.roll_pitch_rad);
@@ -342,7 +342,7 @@ TEST(FitBidirectional, RecoversHardIronAndTheSeedsPhaseOnALevelTurn) {
   EXPECT_EQ(c.method, "bidirectional");
   const double phase_est = std::atan(c.correction(1, 0));
   std::cout << "[bidirectional] h = (" << c.hard_iron_uT.x() << ", " << c.hard_iron_uT.y() << ") uT, phase "
-            << phase_est / kDeg << " deg (truth -15.32), field " << c.field_uT << " uT (truth " << 1.06 * H << ")\n";
+            << phase_est / kDegToRad << " deg (truth -15.32), field " << c.field_uT << " uT (truth " << 1.06 * H << ")\n";
   // Extremes of 0.2 uT noise: ~50 samples compete near each flat peak, so the max and min
   // are both biased outwards by ~2.3 sigma with an sd of ~0.4 sigma each; the bias cancels
   // in the midpoint, the sd does not: 0.06 uT, and 0.25 uT is 4 of those.
@@ -350,7 +350,7 @@ TEST(FitBidirectional, RecoversHardIronAndTheSeedsPhaseOnALevelTurn) {
   EXPECT_NEAR(c.hard_iron_uT.y(), h.y(), 0.25);
   // The phase is averaged over ~120 samples near the x extremes: noise 0.2 / 25 / sqrt(60)
   // ~ 0.06 deg, plus the amplitude bias ~0.2/25 rad ~ 0.5 deg * sin(phase): 0.3 deg.
-  EXPECT_NEAR(phase_est / kDeg, -15.32, 0.3);
+  EXPECT_NEAR(phase_est / kDegToRad, -15.32, 0.3);
   EXPECT_NEAR(c.field_uT, 1.06 * H, 0.6);  // amplitude biased outwards by ~2.3 noise sigma = 0.46 uT
   EXPECT_LT(c.field_spread_after_uT, 0.3);
   EXPECT_GT(c.field_spread_before_uT, 5.0);
@@ -366,7 +366,7 @@ TEST(FitBidirectional, RecoversHardIronAndTheSeedsPhaseOnALevelTurn) {
     ss_after += after * after;
     ++n;
   }
-  const double rms_before_deg = std::sqrt(ss_before / n) / kDeg, rms_after_deg = std::sqrt(ss_after / n) / kDeg;
+  const double rms_before_deg = std::sqrt(ss_before / n) / kDegToRad, rms_after_deg = std::sqrt(ss_after / n) / kDegToRad;
   std::cout << "[bidirectional heading] RMS heading error before " << rms_before_deg << " deg, after "
             << rms_after_deg << " deg\n";
   EXPECT_GT(rms_before_deg, 20.0);
@@ -379,7 +379,7 @@ TEST(FitBidirectional, RejectsAPartialTurnAndTooMuchTilt) {
   std::vector<MagSample> half(turn.samples.begin(), turn.samples.begin() + 360);  // 180 deg
   std::vector<Eigen::Vector2d> half_rp(turn.roll_pitch_rad.begin(), turn.roll_pitch_rad.begin() + 360);
   EXPECT_THROW(FitBidirectional(half, half_rp), std::runtime_error);
-  std::vector<Eigen::Vector2d> all_tilted(turn.samples.size(), Eigen::Vector2d(0.0, 3.0 * kDeg));
+  std::vector<Eigen::Vector2d> all_tilted(turn.samples.size(), Eigen::Vector2d(0.0, 3.0 * kDegToRad));
   try {
     FitBidirectional(turn.samples, all_tilted);
     FAIL();
@@ -407,7 +407,7 @@ MountedTurn SimulateMountedTurn(const Iron& iron, const Eigen::Matrix3d& R_s_b, 
   MountedTurn turn;
   const int n = static_cast<int>(degrees / 0.5);
   for (int i = 0; i < n; ++i) {
-    const double yaw = WrapPi(0.5 * kDeg * i + 0.3);
+    const double yaw = WrapPi(0.5 * kDegToRad * i + 0.3);
     MagSample s;
     s.t_s = 0.02 * i;
     s.m_b_uT = Measure(iron, DcmFromEuler(0.0, 0.0, yaw) * R_s_b.transpose(), noise_uT, rng);
@@ -433,8 +433,8 @@ TEST(FitPlanar, LevelTurnOfASensorOnItsSideRecoversTheInPlaneHardIronAndTheHeadi
   const Eigen::Vector3d o = iron.h_uT + M * Eigen::Vector3d(0.0, 0.0, FieldNed().z());
   const Eigen::Vector3d n = c.uncalibrated_axis;
   // Plane normal from 1440 samples of 0.3 uT noise over a 27 uT circle: ~1e-3 rad.
-  EXPECT_GT(std::abs(n.dot(n_true)), std::cos(0.5 * kDeg)) << n.transpose() << " vs " << n_true.transpose();
-  EXPECT_GT(std::abs(n.y()), std::cos(15.0 * kDeg));  // about the sensor's y axis (S tilts it a little)
+  EXPECT_GT(std::abs(n.dot(n_true)), std::cos(0.5 * kDegToRad)) << n.transpose() << " vs " << n_true.transpose();
+  EXPECT_GT(std::abs(n.y()), std::cos(15.0 * kDegToRad));  // about the sensor's y axis (S tilts it a little)
   EXPECT_NEAR(n.dot(c.hard_iron_uT), 0.0, 1e-9);      // no hard iron along the normal
   EXPECT_NEAR((c.correction * n - n).norm(), 0.0, 1e-9);  // A identity along it
   const Eigen::Vector3d h_error = (Eigen::Matrix3d::Identity() - n * n.transpose()) * (c.hard_iron_uT - o);
@@ -464,7 +464,7 @@ TEST(FitPlanar, LevelTurnOfASensorOnItsSideRecoversTheInPlaneHardIronAndTheHeadi
     ss_after += after * after;
   }
   const double n_samples = static_cast<double>(turn.samples.size());
-  const double rms_before_deg = std::sqrt(ss_before / n_samples) / kDeg, rms_after_deg = std::sqrt(ss_after / n_samples) / kDeg;
+  const double rms_before_deg = std::sqrt(ss_before / n_samples) / kDegToRad, rms_after_deg = std::sqrt(ss_after / n_samples) / kDegToRad;
   std::cout << "[planar heading] RMS heading error before " << rms_before_deg << " deg, after " << rms_after_deg
             << " deg\n";
   EXPECT_GT(rms_before_deg, 10.0);  // 10-30 uT of hard iron against the 27 uT horizontal field
@@ -492,7 +492,7 @@ TEST(FitPlanar, HalfATurnAndASphereAreRefused) {
   EXPECT_THROW(FitPlanar(std::vector<MagSample>(half.samples.begin(), half.samples.begin() + 11)),
                std::invalid_argument);
   PlanarFitOptions bad;
-  bad.min_coverage_deg = 400.0;
+  bad.min_coverage_rad = 400.0 * kDegToRad;
   EXPECT_THROW(FitPlanar(half.samples, bad), std::invalid_argument);
 }
 
@@ -509,7 +509,7 @@ TEST(FitBidirectional, RefusesATurnOutsideTheXYPlaneAndImplausibleSoftIron) {
   }
   // y/x scale 0.4 (beyond the axis ratio 2) and a phase of 45 deg (beyond 36.9 deg).
   for (const auto& [M, expect] : {std::make_pair(TwoAxisIron(1.0, 0.4, 0.0), std::string("y/x scale")),
-                                  std::make_pair(TwoAxisIron(1.0, 1.0, 45.0 * kDeg), std::string("phase"))}) {
+                                  std::make_pair(TwoAxisIron(1.0, 1.0, 45.0 * kDegToRad), std::string("phase"))}) {
     const LevelTurn turn = SimulateTurn(M, Eigen::Vector3d(5.0, 5.0, 0.0), 0.2, rng);
     try {
       FitBidirectional(turn.samples, turn.roll_pitch_rad);
@@ -530,10 +530,10 @@ TEST(FitBidirectional, RefusesATurnOutsideTheXYPlaneAndImplausibleSoftIron) {
 
 TEST(Heading, TiltCompensatedIsExactForTheTrueField) {
   sim::Rng rng(41);
-  const double declination = -4.0 * kDeg;
+  const double declination = -4.0 * kDegToRad;
   for (int i = 0; i < 100; ++i) {
-    const double roll = rng.Uniform(-80.0, 80.0) * kDeg, pitch = rng.Uniform(-80.0, 80.0) * kDeg;
-    const double yaw = rng.Uniform(-180.0, 180.0) * kDeg;
+    const double roll = rng.Uniform(-80.0, 80.0) * kDegToRad, pitch = rng.Uniform(-80.0, 80.0) * kDegToRad;
+    const double yaw = rng.Uniform(-180.0, 180.0) * kDegToRad;
     const Eigen::Vector3d m_b = DcmFromEuler(roll, pitch, yaw).transpose() * FieldNed();
     // Rounding only (atan2 of ~27 uT components).
     EXPECT_NEAR(WrapPi(TiltCompensatedHeading(m_b, roll, pitch, declination) - (yaw + declination)), 0.0, 1e-12);
@@ -544,18 +544,18 @@ TEST(Heading, TiltCompensatedIsExactForTheTrueField) {
 TEST(Heading, TiltErrorBoundIsTheSeeds) {
   // The seed: 2 deg of tilt at 57 deg inclination keeps a 2-axis heading within ~3 deg.
   // atan(tan 57 sin 2) = 3.077 deg; the exact maximum is a little above (cos t factor).
-  EXPECT_NEAR(TiltErrorBound(2.0 * kDeg, kInclination_rad) / kDeg, 3.08, 0.01);
+  EXPECT_NEAR(TiltErrorBound(2.0 * kDegToRad, kInclination_rad) / kDegToRad, 3.08, 0.01);
   // Attained: heading east, pitched by 2 deg; never exceeded at other headings and tilts.
   double worst = 0.0;
   for (int k = 0; k < 360; ++k) {
     for (const Eigen::Vector2d& rp : {Eigen::Vector2d(2.0, 0.0), Eigen::Vector2d(0.0, 2.0), Eigen::Vector2d(-1.4, 1.4)}) {
-      const double yaw = k * kDeg;
-      const Eigen::Vector3d m_b = DcmFromEuler(rp.x() * kDeg, rp.y() * kDeg, yaw).transpose() * FieldNed();
+      const double yaw = k * kDegToRad;
+      const Eigen::Vector3d m_b = DcmFromEuler(rp.x() * kDegToRad, rp.y() * kDegToRad, yaw).transpose() * FieldNed();
       worst = std::max(worst, std::abs(WrapPi(LevelHeading(m_b, 0.0) - yaw)));
     }
   }
-  EXPECT_LE(worst, TiltErrorBound(2.0 * kDeg, kInclination_rad) + 1e-9);
-  EXPECT_GT(worst, TiltErrorBound(2.0 * kDeg, kInclination_rad) - 0.01 * kDeg);  // 1 deg heading grid
+  EXPECT_LE(worst, TiltErrorBound(2.0 * kDegToRad, kInclination_rad) + 1e-9);
+  EXPECT_GT(worst, TiltErrorBound(2.0 * kDegToRad, kInclination_rad) - 0.01 * kDegToRad);  // 1 deg heading grid
   EXPECT_THROW(TiltErrorBound(std::nan(""), 1.0), std::invalid_argument);
 }
 

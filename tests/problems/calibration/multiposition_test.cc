@@ -19,6 +19,7 @@
 #include "core/sim/analytic_trajectory.h"
 #include "core/sim/inertial_errors.h"
 #include "core/sim/random.h"
+#include "core/units.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -110,11 +111,11 @@ sim::InertialErrorConfig Tactical() {
   c.gyro.white_noise = 0.05 * kDegToRad / 60.0;        // 0.05 deg/sqrt(h)
   c.gyro.scale_factor.sigma = 300e-6;
   c.gyro.misalignment.sigma = 0.5e-3;
-  c.accel.bias.sigma = 1e-3 * 9.80665;                 // 1 mg
+  c.accel.bias.sigma = kMilliG_mps2;                 // 1 mg
   c.accel.white_noise = 0.05 / 60.0;                   // 0.05 m/s/sqrt(h)
   c.accel.scale_factor.sigma = 300e-6;
   c.accel.misalignment.sigma = 0.5e-3;
-  c.g_sensitivity.sigma = 1.0 * kDegToRad / 3600.0 / 9.80665;  // 1 deg/h/g
+  c.g_sensitivity.sigma = kDegPerHour_radps / kStandardGravity_mps2;  // 1 deg/h/g
   return c;
 }
 
@@ -342,7 +343,7 @@ sim::TableStep Spin(int axis, double rate_deg_s, double duration_s, double ramp_
   sim::TableStep s;
   s.kind = sim::TableStep::Kind::kRotation;
   s.axis = axis;
-  s.rate_rad_s = rate_deg_s * kDegToRad;
+  s.rate_radps = rate_deg_s * kDegToRad;
   s.duration_s = duration_s;
   s.ramp_s = ramp_s;
   s.dwell_s = dwell_s;
@@ -472,7 +473,7 @@ TEST(ImuCalibrationReportTest, NamesJsonAndText) {
   EXPECT_EQ(GSensitivityParameterName(5), "g_sensitivity.yz");
   EXPECT_THROW(TriadParameterName("accel", 12), std::out_of_range);
   ImuCalibrationResult r;
-  r.calibration.accel(9) = 9.80665e-3;  // 1 mg
+  r.calibration.accel(9) = kMilliG_mps2;  // 1 mg
   r.calibration.gyro(0) = 100e-6;       // 100 ppm
   r.calibration.accel_sigma = Eigen::Matrix<double, 12, 1>::Constant(1e-6);
   r.unobservable.push_back("accel.scale_factor.x: no position puts gravity on x");

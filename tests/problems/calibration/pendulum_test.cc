@@ -30,7 +30,6 @@
 namespace navtwin::calibration {
 namespace {
 
-using sim::kStandardGravity_mps2;
 
 const wgs84::Geodetic kLab{37.45 * kDegToRad, 126.65 * kDegToRad, 40.0};
 constexpr double kRateHz = 100.0;
@@ -41,7 +40,7 @@ constexpr double kAccelVrw = 0.05 / 60.0;            // 0.05 m/s/sqrt(h)
 constexpr double kEncoderNoise_rad = 0.01 * kDegToRad;
 
 Eigen::Matrix3d Mounting(const std::string& yaml) {
-  return sim::ParsePendulumMounting(sim::ParseYaml(yaml, "mounting.yaml"));
+  return sim::ParsePendulumMounting(ParseYaml(yaml, "mounting.yaml"));
 }
 
 /// The seed's three mountings and the one rotated about two axes.
@@ -488,7 +487,7 @@ TEST(PendulumCalibrationTest, RecordThroughSimulatedFiles) {
         MountingKeys()[m] + "}\n" + errors;
     sim::SimulationOptions options;
     options.seed = 20 + m;
-    sims.push_back(std::make_unique<sim::TemporarySimulation>(sim::ParseScenario(sim::ParseYaml(yaml, "s.yaml")),
+    sims.push_back(std::make_unique<sim::TemporarySimulation>(sim::ParseScenario(ParseYaml(yaml, "s.yaml")),
                                                               options, "navtwin_pendulum_sim_"));
     record += "  - {imu: " + sims.back()->path("imu.txt") + ", angle: " + sims.back()->path("angle.csv") +
               ", length_m: 0.8, " + MountingKeys()[m] + "}\n";
@@ -497,14 +496,13 @@ TEST(PendulumCalibrationTest, RecordThroughSimulatedFiles) {
   const ImuCalibrationResult r = CalibratePendulumRecord(dir.Write("record.yaml", record));
   EXPECT_EQ(r.positions, 4);
   ASSERT_EQ(r.estimated.size(), 33u);
-  constexpr double kArcsec = kDegToRad / 3600.0, kDegH = kDegToRad / 3600.0, kUg = 1e-6 * kStandardGravity_mps2;
   Eigen::VectorXd truth(33);
-  truth << -400e-6, 600e-6, 300e-6, -150 * kArcsec, 200 * kArcsec, 100 * kArcsec, -300 * kArcsec, 250 * kArcsec,
-      50 * kArcsec, 1000 * kUg, -500 * kUg, 2000 * kUg,  //
-      500e-6, -300e-6, 200e-6, 200 * kArcsec, -100 * kArcsec, 150 * kArcsec, 300 * kArcsec, -250 * kArcsec,
-      100 * kArcsec, 20 * kDegH, -10 * kDegH, 5 * kDegH,  //
+  truth << -400e-6, 600e-6, 300e-6, -150 * kArcsec_rad, 200 * kArcsec_rad, 100 * kArcsec_rad, -300 * kArcsec_rad, 250 * kArcsec_rad,
+      50 * kArcsec_rad, 1000 * kMicroG_mps2, -500 * kMicroG_mps2, 2000 * kMicroG_mps2,  //
+      500e-6, -300e-6, 200e-6, 200 * kArcsec_rad, -100 * kArcsec_rad, 150 * kArcsec_rad, 300 * kArcsec_rad, -250 * kArcsec_rad,
+      100 * kArcsec_rad, 20 * kDegPerHour_radps, -10 * kDegPerHour_radps, 5 * kDegPerHour_radps,  //
       3, -2, 1, 0, 4, -1, 2, 1, -3;
-  truth.tail(9) *= kDegH / kStandardGravity_mps2;
+  truth.tail(9) *= kDegPerHour_radps / kStandardGravity_mps2;
   const Eigen::VectorXd est = Estimated(r.calibration), sigma = Sigmas(r.calibration);
   for (int i = 0; i < 33; ++i) {
     // One draw of 33 parameters: 4 sigma (false alarm < 0.3 %).

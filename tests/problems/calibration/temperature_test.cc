@@ -35,11 +35,11 @@
 #include "core/sim/random.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
+#include "core/units.h"
 
 namespace navtwin::calibration {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 // ---------------------------------------------------------------------------------------
 // The polynomial fit alone.
@@ -194,7 +194,7 @@ sim::MultiPositionConfig Schedule(const std::vector<Eigen::Vector3d>& euler_deg,
   c.rotation_s = 2.0;
   for (const Eigen::Vector3d& e : euler_deg) {
     sim::TableStep s;
-    s.euler_rad = e * kDeg;
+    s.euler_rad = e * kDegToRad;
     s.dwell_s = dwell_s;
     c.steps.push_back(s);
   }
@@ -235,10 +235,10 @@ TemperatureRun SimulateRun(const sim::InertialErrorConfig& errors, const sim::Mu
   TemperatureRun run;
   run.temperature_degC = temperature_degC;
   run.data.schedule = schedule;
-  run.data.latitude_rad = kLatitudeDeg * kDeg;
+  run.data.latitude_rad = kLatitudeDeg * kDegToRad;
   run.data.height_m = kHeightM;
   run.data.imu_path = "run at " + std::to_string(temperature_degC) + " degC";
-  const wgs84::Geodetic start{kLatitudeDeg * kDeg, 114.0 * kDeg, kHeightM};
+  const wgs84::Geodetic start{kLatitudeDeg * kDegToRad, 114.0 * kDegToRad, kHeightM};
   sim::SynthesizeImu(rig, start, kRateHz, rig.duration_s(), [&](const ImuSample& s, const NavState&) {
     if (s.dt_s <= 0.0) return;  // the initial state, no increment
     ImuSample m = s;
@@ -618,7 +618,7 @@ const std::vector<Eigen::Vector3d> kWarmUpPositionsDeg = {
 /// The exact increments of a table schedule (no sensor error) at rate_hz.
 std::vector<ImuSample> ExactIncrements(const sim::MultiPositionConfig& schedule, double rate_hz) {
   const sim::MultiPositionRig rig(schedule);
-  const wgs84::Geodetic start{kLatitudeDeg * kDeg, 114.0 * kDeg, kHeightM};
+  const wgs84::Geodetic start{kLatitudeDeg * kDegToRad, 114.0 * kDegToRad, kHeightM};
   std::vector<ImuSample> exact;
   sim::SynthesizeImu(rig, start, rate_hz, rig.duration_s(), [&](const ImuSample& s, const NavState&) {
     if (s.dt_s > 0.0) exact.push_back(s);  // the first call is the initial state, no increment
@@ -638,7 +638,7 @@ WarmUpRun WarmUp(const sim::InertialErrorConfig& errors, const sim::MultiPositio
   sim::InertialErrorModel model(e, sim::Rng(seed).Stream("imu"), false);
   WarmUpRun run;
   run.data.schedule = schedule;
-  run.data.latitude_rad = kLatitudeDeg * kDeg;
+  run.data.latitude_rad = kLatitudeDeg * kDegToRad;
   run.data.height_m = kHeightM;
   run.data.imu_path = "warm-up " + std::to_string(seed);
   run.temperature.path = "temperature " + std::to_string(seed);
@@ -836,7 +836,7 @@ TEST_F(TemperatureRecord, WarmUpThroughTheSimulatorFiles) {
       "            temperature: {bias_fixed_ug_per_degC: [20, -10, 15], bias_fixed_ug_per_degC2: [0.3, -0.2, 0.4],\n"
       "                          scale_factor_fixed_ppm_per_degC: [20, -15, 25], scale_factor_fixed_ppm_per_degC2: [0.3, 0.2, -0.4]}}\n"
       "    temperature_profile: {reference_degC: 25, initial_degC: 0, final_degC: 40, time_constant_s: 300}\n";
-  const sim::Scenario scenario = sim::ParseScenario(sim::ParseYaml(scenario_yaml, "warmup.yaml"));
+  const sim::Scenario scenario = sim::ParseScenario(ParseYaml(scenario_yaml, "warmup.yaml"));
   sim::SimulationOptions sim_options;
   sim_options.seed = 44;
   const sim::TemporarySimulation simulation(scenario, sim_options, "navtwin_warmup_");

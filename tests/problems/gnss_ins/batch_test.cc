@@ -21,7 +21,7 @@
 #include "core/sim/presets.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/gnss_ins/inputs.h"
 #include "problems/ins/nav_error.h"
@@ -128,8 +128,8 @@ GnssInsConfig MemsConfig(const SimRecord& r) {
   c.mag.mode = MagConfig::Mode::kVector;
   c.mag.field_ned_uT = Vec3(mag["field_ned_uT"]);
   c.mag.declination_rad = mag["declination_deg"].as<double>() * kDeg;
-  c.mag.hard_iron_uT = Vec3(mag["hard_iron_uT"]);
-  for (int i = 0; i < 3; ++i) c.mag.soft_iron.row(i) = Vec3(mag["soft_iron"][i]).transpose();
+  c.mag.iron.hard_iron_uT = Vec3(mag["hard_iron_uT"]);
+  for (int i = 0; i < 3; ++i) c.mag.iron.soft_iron.row(i) = Vec3(mag["soft_iron"][i]).transpose();
   c.mag.noise_uT = 0.5;
   return c;
 }
@@ -309,7 +309,7 @@ GnssInsConfig NavGradeConfig(const SimRecord& r) {
 class NavGradeOutage : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    record_ = Simulate(sim::ParseScenario(sim::ParseYaml(kNavGradeLap, "batch_test")), 3).release();
+    record_ = Simulate(sim::ParseScenario(ParseYaml(kNavGradeLap, "batch_test")), 3).release();
     config_ = new GnssInsConfig(NavGradeConfig(*record_));
     inputs_ = new Inputs(Load(*record_, *config_, false, true));
     filter_ = new FilterResult(RunFilter(*inputs_, *config_, false, {}, nullptr));

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
+#include "core/units.h"
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin::gnss_ins {
@@ -19,7 +20,6 @@ using navtwin::testing::MakeTempDir;
 using navtwin::testing::WriteFile;
 using navtwin::testing::WriteTempFile;
 
-constexpr double kG0 = 9.80665;
 // Unit conversions are exact products of double constants: compare to 1e-15 relative.
 constexpr double kRel = 1e-15;
 
@@ -69,7 +69,7 @@ TEST(GnssInsConfig, FullFileConvertsUnits) {
   EXPECT_NEAR(c.imu_noise.gyro_arw_rad_per_sqrt_s, 3.0 * kDegToRad / 60.0, 1e-18);
   EXPECT_NEAR(c.imu_noise.accel_vrw_mps_per_sqrt_s, 0.01, kRel);
   EXPECT_NEAR(c.imu_noise.gyro_bias_std_radps, 144.0 * kDegToRad / 3600.0, kRel);
-  EXPECT_NEAR(c.imu_noise.accel_bias_std_mps2, 25500e-6 * kG0, kRel);
+  EXPECT_NEAR(c.imu_noise.accel_bias_std_mps2, 25500e-6 * kStandardGravity_mps2, kRel);
   EXPECT_NEAR(c.imu_noise.gyro_scale_std, 2000e-6, kRel);
   EXPECT_NEAR(c.imu_noise.accel_scale_std, 1000e-6, kRel);
   EXPECT_TRUE(std::isinf(c.imu_noise.correlation_time_s));
@@ -96,8 +96,8 @@ TEST(GnssInsConfig, FullFileConvertsUnits) {
   EXPECT_NEAR(c.mag.field_ned_uT.y(), 50 * std::cos(I) * std::sin(D), 1e-12);
   EXPECT_NEAR(c.mag.field_ned_uT.z(), 50 * std::sin(I), 1e-12);
   EXPECT_NEAR(c.mag.declination_rad, D, kRel);
-  EXPECT_EQ(c.mag.soft_iron(1, 1), -0.02);
-  EXPECT_EQ(c.mag.hard_iron_uT, Eigen::Vector3d(14, 2.4, -4.2));
+  EXPECT_EQ(c.mag.iron.soft_iron(1, 1), -0.02);
+  EXPECT_EQ(c.mag.iron.hard_iron_uT, Eigen::Vector3d(14, 2.4, -4.2));
   EXPECT_NEAR(c.mag.heading_std_rad, 2 * kDegToRad, kRel);
   EXPECT_TRUE(c.baro.use);
   EXPECT_EQ(c.baro.std_m, 2.0);

@@ -25,7 +25,7 @@
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/ins/nav_error.h"
 #include "solvers/eskf.h"
@@ -52,7 +52,7 @@ const SimRecord& PresetRecord(const std::string& preset) {
 }
 
 sim::Scenario ScenarioFromYaml(const std::string& yaml) {
-  return sim::ParseScenario(sim::ParseYaml(yaml, "test scenario"));
+  return sim::ParseScenario(ParseYaml(yaml, "test scenario"));
 }
 
 
@@ -106,8 +106,8 @@ void UseMagnetometer(const SimRecord& r, MagConfig::Mode mode, GnssInsConfig* c)
   c->mag.mode = mode;
   c->mag.field_ned_uT = Vec3(mag["field_ned_uT"]);
   c->mag.declination_rad = mag["declination_deg"].as<double>() * kDegToRad;
-  c->mag.hard_iron_uT = Vec3(mag["hard_iron_uT"]);
-  c->mag.soft_iron = Mat3(mag["soft_iron"]);
+  c->mag.iron.hard_iron_uT = Vec3(mag["hard_iron_uT"]);
+  c->mag.iron.soft_iron = Mat3(mag["soft_iron"]);
   c->mag.noise_uT = mag["noise_uT"].as<double>();
   // Per-axis noise over the horizontal field: 0.1 uT / 27 uT = 0.2 deg of heading noise.
   c->mag.heading_std_rad = c->mag.noise_uT / c->mag.field_ned_uT.head<2>().norm();
@@ -173,10 +173,10 @@ TEST(GnssInsFilter, SigmasCalibrationAndInitialStd) {
 
   // The simulator's model m = (I + S) m_true + h, undone exactly (to rounding).
   MagConfig mag;
-  mag.hard_iron_uT = Eigen::Vector3d(5.0, -3.0, 12.0);
-  mag.soft_iron << 0.02, -0.01, 0.005, 0.015, -0.03, 0.0, -0.02, 0.01, 0.01;
+  mag.iron.hard_iron_uT = Eigen::Vector3d(5.0, -3.0, 12.0);
+  mag.iron.soft_iron << 0.02, -0.01, 0.005, 0.015, -0.03, 0.0, -0.02, 0.01, 0.01;
   const Eigen::Vector3d m_true(21.0, -4.0, 40.0);
-  const Eigen::Vector3d m_raw = (Eigen::Matrix3d::Identity() + mag.soft_iron) * m_true + mag.hard_iron_uT;
+  const Eigen::Vector3d m_raw = (Eigen::Matrix3d::Identity() + mag.iron.soft_iron) * m_true + mag.iron.hard_iron_uT;
   EXPECT_LT((CalibrateMag(m_raw, mag) - m_true).norm(), 1e-12);
 
   GnssInsConfig c;

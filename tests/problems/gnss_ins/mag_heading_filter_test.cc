@@ -19,6 +19,7 @@
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
+#include "core/units.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/ins/nav_error.h"
 #include "tests/problems/gnss_ins/sim_record.h"
@@ -43,7 +44,7 @@ TEST(MagHeadingFilter, LevelFlightHonestSigmaStaysAccurateAndConsistent) {
   c.imu_noise.gyro_arw_rad_per_sqrt_s = 2.0 * imu["gyro"]["arw_deg_sqrt_h"].as<double>() * kDegToRad / 60.0;
   c.imu_noise.accel_vrw_mps_per_sqrt_s = 2.0 * imu["accel"]["vrw_m_s_sqrt_h"].as<double>() / 60.0;
   c.imu_noise.gyro_bias_std_radps = 144.0 * kDegToRad / 3600.0;
-  c.imu_noise.accel_bias_std_mps2 = 25500.0 * 9.80665e-6;
+  c.imu_noise.accel_bias_std_mps2 = 25500.0 * kMicroG_mps2;
   c.imu_noise.correlation_time_s = 3600.0;
   c.init.source = InitConfig::Source::kGiven;
   c.init.state = InsState{init, ImuErrors{}};
@@ -54,8 +55,8 @@ TEST(MagHeadingFilter, LevelFlightHonestSigmaStaysAccurateAndConsistent) {
   const YAML::Node mag = errors["mag"];
   c.mag.mode = MagConfig::Mode::kHeading;
   c.mag.declination_rad = mag["declination_deg"].as<double>() * kDegToRad;
-  c.mag.hard_iron_uT = Vec3(mag["hard_iron_uT"]);
-  for (int i = 0; i < 3; ++i) c.mag.soft_iron.row(i) = Vec3(mag["soft_iron"][i]).transpose();
+  c.mag.iron.hard_iron_uT = Vec3(mag["hard_iron_uT"]);
+  for (int i = 0; i < 3; ++i) c.mag.iron.soft_iron.row(i) = Vec3(mag["soft_iron"][i]).transpose();
   // The projected noise: per-axis noise over the horizontal intensity, 0.1 / 27.2 uT =
   // 0.21 deg (the vertical noise does not enter to first order). No field vector given.
   c.mag.heading_std_rad = mag["noise_uT"].as<double>() / Vec3(mag["field_ned_uT"]).head<2>().norm();

@@ -18,7 +18,8 @@
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
+#include "core/units.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/ins/nav_error.h"
@@ -55,8 +56,6 @@ mag: {rate_hz: 10, declination_deg: -8.0, noise_uT: 0.3}
 )";
 
 constexpr int kRuns = 50;
-constexpr double kDegPerHour = kDegToRad / 3600.0;
-constexpr double kMicroG = 9.80665e-6;
 
 struct RunNees {
   std::vector<double> filter;  ///< NEES at each check epoch
@@ -73,15 +72,15 @@ RunNees OneRun(const sim::Scenario& scenario, std::uint64_t seed, const std::vec
 
   // The true IMU errors of this run (constant biases).
   ImuErrors true_imu;
-  true_imu.bg_radps = test_records::Vec3(errors["imu"]["errors"]["gyro"]["bias_deg_h"]) * kDegPerHour;
-  true_imu.ba_mps2 = test_records::Vec3(errors["imu"]["errors"]["accel"]["bias_ug"]) * kMicroG;
+  true_imu.bg_radps = test_records::Vec3(errors["imu"]["errors"]["gyro"]["bias_deg_h"]) * kDegPerHour_radps;
+  true_imu.ba_mps2 = test_records::Vec3(errors["imu"]["errors"]["accel"]["bias_ug"]) * kMicroG_mps2;
 
   // The model of the scenario's sensors, taken honestly from its parameters.
   GnssInsConfig c;
   c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.5 * kDegToRad / 60.0;
   c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.1 / 60.0;
-  c.imu_noise.gyro_bias_std_radps = 20.0 * kDegPerHour;
-  c.imu_noise.accel_bias_std_mps2 = 2000.0 * kMicroG;
+  c.imu_noise.gyro_bias_std_radps = 20.0 * kDegPerHour_radps;
+  c.imu_noise.accel_bias_std_mps2 = 2000.0 * kMicroG_mps2;
   c.imu_noise.correlation_time_s = std::numeric_limits<double>::infinity();  // constants
   c.installation.antenna_lever_arm_b_m = Eigen::Vector3d(0.3, 0.0, -0.5);
   c.mag.mode = MagConfig::Mode::kVector;
@@ -123,7 +122,7 @@ RunNees OneRun(const sim::Scenario& scenario, std::uint64_t seed, const std::vec
 }
 
 TEST(GnssInsFilterNees, FiftyRunsWithinChiSquareBounds) {
-  const sim::Scenario scenario = sim::ParseScenario(sim::ParseYaml(kNeesScenario, "nees scenario"));
+  const sim::Scenario scenario = sim::ParseScenario(ParseYaml(kNeesScenario, "nees scenario"));
   // Epochs in the turns, the climb, the S-turns and the cruise (GNSS epochs: knots).
   const std::vector<double> check_s = {10.0, 30.0, 50.0, 80.0, 110.0, 140.0};
   std::vector<double> mean(check_s.size(), 0.0), mean_rts(check_s.size(), 0.0);

@@ -13,6 +13,7 @@
 
 #include "core/io/kfgins.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin::gnss_ins {
@@ -50,7 +51,7 @@ NavEpoch Epoch(double t, int n_std) {
   e.state.nav.v_n_mps = Eigen::Vector3d(1.0, 2.0, -0.5);
   e.state.nav.q_n_b = QuatFromEuler(1.0 * kDegToRad, -2.0 * kDegToRad, 100.0 * kDegToRad);
   e.state.imu.bg_radps = Eigen::Vector3d(10.0, 0, 0) * kDegToRad / 3600.0;  // 10 deg/h
-  e.state.imu.ba_mps2 = Eigen::Vector3d(0, 2e-3 * 9.80665, 0);            // 2 mg
+  e.state.imu.ba_mps2 = Eigen::Vector3d(0, 2.0 * kMilliG_mps2, 0);            // 2 mg
   e.state.imu.sg = Eigen::Vector3d(0, 0, 300e-6);                          // 300 ppm
   e.state.imu.sa = Eigen::Vector3d(100e-6, 0, 0);
   e.std = Eigen::VectorXd::Constant(n_std, 0.0);
@@ -59,7 +60,7 @@ NavEpoch Epoch(double t, int n_std) {
     e.std.segment<3>(3).setConstant(0.05);                             // m/s
     e.std.segment<3>(6).setConstant(0.2 * kDegToRad);                  // 0.2 deg
     e.std.segment<3>(9).setConstant(5.0 * kDegToRad / 3600.0);         // 5 deg/h
-    e.std.segment<3>(12).setConstant(0.5e-3 * 9.80665);                // 0.5 mg
+    e.std.segment<3>(12).setConstant(0.5 * kMilliG_mps2);                // 0.5 mg
   }
   if (n_std == 21) e.std.segment<6>(15).setConstant(200e-6);           // 200 ppm
   return e;

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "core/earth.h"
+#include "core/units.h"
 #include "core/sim/presets.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
@@ -27,7 +28,6 @@ namespace {
 
 using test_records::TruthAt;
 
-constexpr double kDeg = M_PI / 180.0;
 // One 300 s lap of the preset: the outage covers the first turn and the S-bends.
 constexpr double kEnd_s = 300.0;
 constexpr double kOutageStart_s = 90.0;  // after the first IMU epoch
@@ -54,17 +54,17 @@ class Car : public ::testing::Test {
   /// The preset's specification as a user writes it, GNSS outage included.
   static GnssInsConfig Config() {
     GnssInsConfig c;
-    c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.3 * kDeg / 60.0;
-    c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.1 / 60.0;
-    c.imu_noise.gyro_bias_std_radps = 10.0 * kDeg / 3600.0;
-    c.imu_noise.accel_bias_std_mps2 = 2e-3 * 9.80665;
+    c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.3 * kDegPerSqrtHour_radpsqrts;
+    c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.1 * kMpsPerSqrtHour_mpspsqrts;
+    c.imu_noise.gyro_bias_std_radps = 10.0 * kDegPerHour_radps;
+    c.imu_noise.accel_bias_std_mps2 = 2.0 * kMilliG_mps2;
     c.imu_noise.correlation_time_s = INFINITY;
     c.installation.antenna_lever_arm_b_m = Eigen::Vector3d(0.0, 0.0, -1.0);
     c.init.source = InitConfig::Source::kGiven;
     c.init.state = InsState{test_records::ReadAll<NavState>(OpenNav(*dir_ + "/init.nav")).front(), ImuErrors{}};
     c.init.std.pos_ned_m = Eigen::Vector3d(2.0, 2.0, 3.0);
     c.init.std.vel_ned_mps.setConstant(0.1);
-    c.init.std.att_rad = Eigen::Vector3d(1.0, 1.0, 3.0) * kDeg;
+    c.init.std.att_rad = Eigen::Vector3d(1.0, 1.0, 3.0) * kDegToRad;
     c.end_time_s = kEnd_s;
     c.outages.start_s = kOutageStart_s;
     c.outages.len_s = kOutageLen_s;

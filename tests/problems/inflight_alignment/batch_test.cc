@@ -29,14 +29,12 @@
 #include "core/earth.h"
 #include "core/rotation.h"
 #include "core/sim/random.h"
+#include "core/units.h"
 #include "problems/inflight_alignment/distance_heading.h"
 
 namespace navtwin::inflight {
 namespace {
 
-constexpr double kArcmin = kDegToRad / 60.0;
-constexpr double kDegPerHour = kDegToRad / 3600.0;
-constexpr double kMicroG = 1e-6 * 9.80665;
 constexpr double kLat = 36.5 * kDegToRad;
 constexpr double kGpsSigma = 17.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -46,10 +44,10 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 Eigen::Vector2d OneSigma(double sigma, double sign_north) { return sigma * Eigen::Vector2d(sign_north, -sign_north); }
 
 struct Truth {
-  double dh = 20.0 * kArcmin;
-  Eigen::Vector2d eps = OneSigma(InflightConfig().initial.level_arcmin * kArcmin, 1.0);
-  Eigen::Vector2d df = OneSigma(InflightConfig().sensors.accel_bias_ug * kMicroG, 1.0);
-  Eigen::Vector2d dw = OneSigma(InflightConfig().sensors.gyro_bias_deg_h * kDegPerHour, -1.0);
+  double dh = 20.0 * kArcmin_rad;
+  Eigen::Vector2d eps = OneSigma(InflightConfig().initial.level_rad, 1.0);
+  Eigen::Vector2d df = OneSigma(InflightConfig().sensors.accel_bias_mps2, 1.0);
+  Eigen::Vector2d dw = OneSigma(InflightConfig().sensors.gyro_bias_radps, -1.0);
   Eigen::Vector2d p0 = OneSigma(InflightConfig().initial.position_m, 1.0);
   Eigen::Vector2d v0 = OneSigma(InflightConfig().initial.velocity_mps, -1.0);
   /// Level random walk intensity (rad/sqrt(s)) drawn by MakeFlight; 0: constant level.
@@ -59,7 +57,7 @@ struct Truth {
 };
 
 // The default configuration's gyro angle random walk, deg/sqrt(h) -> rad/sqrt(s).
-double DefaultArw() { return InflightConfig().sensors.gyro_arw_deg_sqrt_h * kDegToRad / 60.0; }
+double DefaultArw() { return InflightConfig().sensors.gyro_arw_rad_per_sqrt_s; }
 
 double SchulerRateHere() { return SchulerRate(kLat, 1000.0); }
 // The batch takes gravity at the start from NormalGravity(lat, 0) (batch.cc); so does the model.
@@ -210,9 +208,9 @@ TEST(InflightBatch, RecoversTheModelWithoutNoise) {
     EXPECT_GT(s.iterations, 0);
     // The level and accelerometer split is the priors': each sigma stays near its prior
     // (0.34', 100 ug), the combination being known.
-    EXPECT_GT(s.level_sigma_rad[0], 0.5 * 0.34 * kArcmin);
-    EXPECT_LT(s.level_sigma_rad[0], 0.34 * kArcmin * 1.0001);
-    EXPECT_GT(s.accel_bias_sigma_mps2[1], 0.5 * 100.0 * kMicroG);
+    EXPECT_GT(s.level_sigma_rad[0], 0.5 * 0.34 * kArcmin_rad);
+    EXPECT_LT(s.level_sigma_rad[0], 0.34 * kArcmin_rad * 1.0001);
+    EXPECT_GT(s.accel_bias_sigma_mps2[1], 0.5 * 100.0 * kMicroG_mps2);
   }
   // With the default 30 s steps the data leave the split of the level ramp between gyro
   // bias and steps, and of v0 and dH, to the priors; on noise-free data the MAP is then off
@@ -229,12 +227,12 @@ TEST(InflightBatch, RecoversTheModelWithoutNoise) {
 // widened by Omega cos L x 30', batch.h), dH = 20'.
 Truth DrawFromPriors(sim::Rng& rng) {
   const InflightConfig c;
-  const double gyro = c.sensors.gyro_bias_deg_h * kDegPerHour;
-  const double coupling = wgs84::kOmegaIe_rad_s * std::cos(kLat) * c.initial.heading_arcmin * kArcmin;
+  const double gyro = c.sensors.gyro_bias_radps;
+  const double coupling = wgs84::kOmegaIe_radps * std::cos(kLat) * c.initial.heading_rad;
   const auto normal2 = [&rng](double sn, double se) { return Eigen::Vector2d(sn * rng.Normal(), se * rng.Normal()); };
   Truth x;
-  x.eps = normal2(c.initial.level_arcmin * kArcmin, c.initial.level_arcmin * kArcmin);
-  x.df = normal2(c.sensors.accel_bias_ug * kMicroG, c.sensors.accel_bias_ug * kMicroG);
+  x.eps = normal2(c.initial.level_rad, c.initial.level_rad);
+  x.df = normal2(c.sensors.accel_bias_mps2, c.sensors.accel_bias_mps2);
   x.dw = normal2(gyro, std::hypot(gyro, coupling));
   x.p0 = normal2(c.initial.position_m, c.initial.position_m);
   x.v0 = normal2(c.initial.velocity_mps, c.initial.velocity_mps);
@@ -283,9 +281,9 @@ TEST(InflightBatch, SigmaMatchesTheSpreadOver50Seeds) {
     const double rms_full = Rms(mc.error_full), sigma_full = Mean(mc.sigma_full);
     const double rms_10km = Rms(mc.error_10km), sigma_10km = Mean(mc.sigma_10km);
     std::cout << "[ info ] " << (from_priors ? "unknowns from priors" : "unknowns at +-1 sigma")
-              << ", level walk: dH whole flight RMS error " << rms_full / kArcmin << "', mean sigma "
-              << sigma_full / kArcmin << "'; first 10 km RMS error " << rms_10km / kArcmin << "', mean sigma "
-              << sigma_10km / kArcmin << "'; " << mc.seconds_per_solve * 1e3 << " ms per whole-flight solve\n";
+              << ", level walk: dH whole flight RMS error " << rms_full / kArcmin_rad << "', mean sigma "
+              << sigma_full / kArcmin_rad << "'; first 10 km RMS error " << rms_10km / kArcmin_rad << "', mean sigma "
+              << sigma_10km / kArcmin_rad << "'; " << mc.seconds_per_solve * 1e3 << " ms per whole-flight solve\n";
     // The RMS of N = 50 Gaussian errors scatters by 1/sqrt(2N) = 10 % around their
     // standard deviation; 30 % is three of those. With unknowns drawn from the priors the
     // posterior sigma is that standard deviation (linear-Gaussian MAP; the walk drawn at
@@ -309,8 +307,8 @@ TEST(InflightBatch, WithoutTheStepsTheLevelWalkMakesSigmaTooSmall) {
   const MonteCarlo mc = RunMonteCarlo(true, off, false);
   EXPECT_EQ(mc.tilt_steps, 0);
   const double rms = Rms(mc.error_full), sigma = Mean(mc.sigma_full);
-  std::cout << "[ info ] unknowns from priors, level walk, no steps: dH whole flight RMS error " << rms / kArcmin
-            << "', mean sigma " << sigma / kArcmin << "'; " << mc.seconds_per_solve * 1e3
+  std::cout << "[ info ] unknowns from priors, level walk, no steps: dH whole flight RMS error " << rms / kArcmin_rad
+            << "', mean sigma " << sigma / kArcmin_rad << "'; " << mc.seconds_per_solve * 1e3
             << " ms per whole-flight solve\n";
   // The estimates hardly change with the steps (measured RMS 0.82' either way) but the
   // sigma does (0.70' without, 0.87' with): the expected ratio is about 0.87 / 0.70 = 1.24,
@@ -338,7 +336,7 @@ TEST(InflightBatch, RecoversLevelStepsAtTheSegmentBoundaries) {
   // the truth. Measured at x100: dH 1.9e-9 rad off, residual RMS 2e-6 m, dw 3e-10 rad/s,
   // p0 1e-6 m, v0 3e-7 m/s; the bounds are 5-10 x those.
   InflightConfig loose;
-  loose.sensors.gyro_arw_deg_sqrt_h *= 100.0;
+  loose.sensors.gyro_arw_rad_per_sqrt_s *= 100.0;
   const BatchHeadingSolution s = Solve(f.epochs, 0.01, loose);
   EXPECT_EQ(s.tilt_steps, 18);
   EXPECT_NEAR(s.dh_rad, x.dh, 1e-8);
@@ -361,7 +359,7 @@ TEST(InflightBatch, StepCountFollowsTheSegmentAndTheArw) {
   const auto steps = [&f](double segment_s, double arw_deg_sqrt_h) {
     InflightConfig config;
     config.batch.tilt_segment_s = segment_s;
-    config.sensors.gyro_arw_deg_sqrt_h = arw_deg_sqrt_h;
+    config.sensors.gyro_arw_rad_per_sqrt_s = arw_deg_sqrt_h * kDegPerSqrtHour_radpsqrts;
     return Solve(f.epochs, kGpsSigma, config).tilt_steps;
   };
   EXPECT_EQ(steps(30.0, 0.005), 18);   // 30 .. 540
@@ -398,8 +396,8 @@ TEST(InflightBatch, CauchyLossResistsOutliers) {
     error_none.push_back(plain.dh_rad - x.dh);
   }
   const double rms_cauchy = Rms(error_cauchy), rms_none = Rms(error_none);
-  std::cout << "[ info ] 1 % outliers of 200 m, 20 seeds: RMS dH error Cauchy " << rms_cauchy / kArcmin
-            << "' (mean sigma " << Mean(sigma_cauchy) / kArcmin << "'), no loss " << rms_none / kArcmin << "'\n";
+  std::cout << "[ info ] 1 % outliers of 200 m, 20 seeds: RMS dH error Cauchy " << rms_cauchy / kArcmin_rad
+            << "' (mean sigma " << Mean(sigma_cauchy) / kArcmin_rad << "'), no loss " << rms_none / kArcmin_rad << "'\n";
   EXPECT_GT(rms_none, rms_cauchy);
 }
 
@@ -423,7 +421,7 @@ TEST(InflightBatch, ZeroSpecHoldsTheTermAtZero) {
   Truth no_accel = x;
   no_accel.df.setZero();
   InflightConfig config;
-  config.sensors.accel_bias_ug = 0.0;
+  config.sensors.accel_bias_mps2 = 0.0;
   config.batch.tilt_segment_s = 0.0;  // the constant-level model: RecoversTheModelWithoutNoise
   const BatchHeadingSolution s = Solve(MakeFlight(no_accel, 0.0, 2).epochs, 0.01, config);
   EXPECT_EQ(s.accel_bias_ne_mps2, Eigen::Vector2d::Zero());
@@ -479,10 +477,10 @@ TEST(InflightBatch, RejectsBadInput) {
   bad_scale.batch.loss_scale_sigma = 0.0;
   expect_invalid(f.epochs, kGpsSigma, "loss_scale_sigma", bad_scale);
   InflightConfig bad_prior;
-  bad_prior.initial.level_arcmin = -1.0;
+  bad_prior.initial.level_rad = -1.0;
   expect_invalid(f.epochs, kGpsSigma, "initial.level_arcmin", bad_prior);
   InflightConfig bad_arw;
-  bad_arw.sensors.gyro_arw_deg_sqrt_h = -0.005;
+  bad_arw.sensors.gyro_arw_rad_per_sqrt_s = -0.005;
   expect_invalid(f.epochs, kGpsSigma, "sensors.gyro_arw_deg_sqrt_h", bad_arw);
   // 0.1 s segments: 5450 steps over 545 s, above the 1000 the batch accepts.
   for (const double segment_s : {-30.0, kNaN, std::numeric_limits<double>::infinity(), 0.1}) {

@@ -54,15 +54,15 @@ batch:
 
 TEST(InflightConfigTest, EveryKeyIsRead) {
   const InflightConfig c = ParseInflightConfig(kEveryKey, "every.yaml");
-  EXPECT_EQ(c.sensors.gyro_bias_deg_h, 0.02);
-  EXPECT_EQ(c.sensors.gyro_arw_deg_sqrt_h, 0.006);
-  EXPECT_EQ(c.sensors.accel_bias_ug, 50.0);
-  EXPECT_EQ(c.sensors.accel_vrw_m_s_sqrt_h, 0.001);
+  EXPECT_EQ(c.sensors.gyro_bias_radps, 0.02 * kDegPerHour_radps);
+  EXPECT_EQ(c.sensors.gyro_arw_rad_per_sqrt_s, 0.006 * kDegPerSqrtHour_radpsqrts);
+  EXPECT_EQ(c.sensors.accel_bias_mps2, 50.0 * kMicroG_mps2);
+  EXPECT_EQ(c.sensors.accel_vrw_mps_per_sqrt_s, 0.001 * kMpsPerSqrtHour_mpspsqrts);
   EXPECT_EQ(c.sensors.gps_sigma_m, 12.0);
   EXPECT_EQ(c.initial.position_m, 5.0);
   EXPECT_EQ(c.initial.velocity_mps, 0.2);
-  EXPECT_EQ(c.initial.level_arcmin, 0.5);
-  EXPECT_EQ(c.initial.heading_arcmin, 60.0);
+  EXPECT_EQ(c.initial.level_rad, 0.5 * kArcmin_rad);
+  EXPECT_EQ(c.initial.heading_rad, 60.0 * kArcmin_rad);
   EXPECT_EQ(c.baro.time_constant_s, 30.0);
   // Both opposite to the defaults (distance smooths, kalman does not).
   EXPECT_FALSE(c.smooth_gps_distance);
@@ -80,8 +80,8 @@ TEST(InflightConfigTest, EveryKeyIsRead) {
   EXPECT_EQ(s.max_position_sigma_m, 90.0);
   EXPECT_EQ(s.gate_probability, 0.999);
   EXPECT_EQ(s.reset_after_rejections, 4);
-  EXPECT_EQ(c.distance.threshold_km, 8.0);
-  EXPECT_EQ(c.distance.recompute_every_km, 5.0);
+  EXPECT_EQ(c.distance.threshold_m, 8e3);
+  EXPECT_EQ(c.distance.recompute_every_m, 5e3);
   EXPECT_EQ(c.batch.loss, RobustLoss::kHuber);
   EXPECT_EQ(c.batch.loss_scale_sigma, 2.5);
   EXPECT_EQ(c.batch.max_iterations, 80);
@@ -92,8 +92,8 @@ TEST(InflightConfigTest, EmptyTextGivesTheDefaults) {
   const InflightConfig c = ParseInflightConfig("", "empty.yaml");
   const InflightConfig d;
   EXPECT_EQ(c.sensors.gps_sigma_m, d.sensors.gps_sigma_m);
-  EXPECT_EQ(c.initial.heading_arcmin, d.initial.heading_arcmin);
-  EXPECT_EQ(c.distance.threshold_km, d.distance.threshold_km);
+  EXPECT_EQ(c.initial.heading_rad, d.initial.heading_rad);
+  EXPECT_EQ(c.distance.threshold_m, d.distance.threshold_m);
   EXPECT_EQ(c.batch.loss, d.batch.loss);
   EXPECT_EQ(c.smoother.noise_window_fixes, d.smoother.noise_window_fixes);
 }
@@ -105,14 +105,14 @@ TEST(InflightConfigTest, ShippedPresetFileHoldsTheDefaultsAndTheGpsSigma) {
       LoadInflightConfig(std::string(NAVTWIN_SOURCE_DIR) + "/data/configs/inflight-mach07-south.yaml");
   const InflightConfig d;
   EXPECT_EQ(c.sensors.gps_sigma_m, 17.0);
-  EXPECT_EQ(c.sensors.gyro_bias_deg_h, d.sensors.gyro_bias_deg_h);
-  EXPECT_EQ(c.sensors.gyro_arw_deg_sqrt_h, d.sensors.gyro_arw_deg_sqrt_h);
-  EXPECT_EQ(c.sensors.accel_bias_ug, d.sensors.accel_bias_ug);
-  EXPECT_EQ(c.sensors.accel_vrw_m_s_sqrt_h, d.sensors.accel_vrw_m_s_sqrt_h);
+  EXPECT_EQ(c.sensors.gyro_bias_radps, d.sensors.gyro_bias_radps);
+  EXPECT_EQ(c.sensors.gyro_arw_rad_per_sqrt_s, d.sensors.gyro_arw_rad_per_sqrt_s);
+  EXPECT_EQ(c.sensors.accel_bias_mps2, d.sensors.accel_bias_mps2);
+  EXPECT_EQ(c.sensors.accel_vrw_mps_per_sqrt_s, d.sensors.accel_vrw_mps_per_sqrt_s);
   EXPECT_EQ(c.initial.position_m, d.initial.position_m);
   EXPECT_EQ(c.initial.velocity_mps, d.initial.velocity_mps);
-  EXPECT_EQ(c.initial.level_arcmin, d.initial.level_arcmin);
-  EXPECT_EQ(c.initial.heading_arcmin, d.initial.heading_arcmin);
+  EXPECT_EQ(c.initial.level_rad, d.initial.level_rad);
+  EXPECT_EQ(c.initial.heading_rad, d.initial.heading_rad);
   EXPECT_EQ(c.baro.time_constant_s, d.baro.time_constant_s);
   EXPECT_EQ(c.smooth_gps_distance, d.smooth_gps_distance);
   EXPECT_EQ(c.smooth_gps_kalman, d.smooth_gps_kalman);
@@ -128,8 +128,8 @@ TEST(InflightConfigTest, ShippedPresetFileHoldsTheDefaultsAndTheGpsSigma) {
   EXPECT_EQ(c.smoother.max_position_sigma_m, d.smoother.max_position_sigma_m);
   EXPECT_EQ(c.smoother.gate_probability, d.smoother.gate_probability);
   EXPECT_EQ(c.smoother.reset_after_rejections, d.smoother.reset_after_rejections);
-  EXPECT_EQ(c.distance.threshold_km, d.distance.threshold_km);
-  EXPECT_EQ(c.distance.recompute_every_km, d.distance.recompute_every_km);
+  EXPECT_EQ(c.distance.threshold_m, d.distance.threshold_m);
+  EXPECT_EQ(c.distance.recompute_every_m, d.distance.recompute_every_m);
   EXPECT_EQ(c.batch.loss, d.batch.loss);
   EXPECT_EQ(c.batch.loss_scale_sigma, d.batch.loss_scale_sigma);
   EXPECT_EQ(c.batch.max_iterations, d.batch.max_iterations);
@@ -144,8 +144,8 @@ TEST(InflightConfigTest, ZeroIsAcceptedWhereItMeansNoneOrEstimate) {
       "batch: {tilt_segment_s: 0}\n",
       "zero.yaml");
   EXPECT_EQ(c.sensors.gps_sigma_m, 0.0);
-  EXPECT_EQ(c.sensors.gyro_bias_deg_h, 0.0);
-  EXPECT_EQ(c.distance.recompute_every_km, 0.0);
+  EXPECT_EQ(c.sensors.gyro_bias_radps, 0.0);
+  EXPECT_EQ(c.distance.recompute_every_m, 0.0);
   EXPECT_EQ(c.batch.tilt_segment_s, 0.0);  // no level random walk in the batch
   EXPECT_EQ(c.smoother.initial_position_sigma_ned_m, Eigen::Vector3d::Constant(8.0));  // scalar: every axis
 }

@@ -19,14 +19,11 @@
 #include "core/earth.h"
 #include "core/rotation.h"
 #include "core/sim/random.h"
+#include "core/units.h"
 
 namespace navtwin::inflight {
 namespace {
 
-constexpr double kArcmin = kDegToRad / 60.0;
-constexpr double kG = 9.80665;
-constexpr double kDegPerHour = kDegToRad / 3600.0;
-constexpr double kMicroG = 1e-6 * kG;
 
 // Rotation of a north-east vector by a (from north towards east): heading + a.
 Eigen::Vector2d RotateNe(const Eigen::Vector2d& ne, double a) {
@@ -38,7 +35,7 @@ Eigen::Vector2d RotateNe(const Eigen::Vector2d& ne, double a) {
 
 TEST(DistanceHeading, Equation8MatchesGeometryInAllQuadrants) {
   for (const double heading_deg : {0.0, 30.0, 90.0, 120.0, 180.0, 210.0, 270.0, 300.0}) {
-    for (const double dh : {20.0 * kArcmin, -20.0 * kArcmin, 2.0 * kDegToRad}) {
+    for (const double dh : {20.0 * kArcmin_rad, -20.0 * kArcmin_rad, 2.0 * kDegToRad}) {
       const double psi = heading_deg * kDegToRad;
       const Eigen::Vector2d truth = 10e3 * Eigen::Vector2d(std::cos(psi), std::sin(psi));
       const Eigen::Vector2d ins = RotateNe(truth, dh);  // INS heading dh too large
@@ -47,7 +44,7 @@ TEST(DistanceHeading, Equation8MatchesGeometryInAllQuadrants) {
       // Equation 8 is atan(sin dh) = dh - dh^3/2 + O(dh^5) (header): 1e-7 rad at 20',
       // 2.1e-5 rad at 2 deg; the tolerance is that term plus rounding.
       EXPECT_NEAR(r.dh_rad, dh, 0.5 * std::abs(dh * dh * dh) * 1.01 + 1e-12)
-          << "heading " << heading_deg << " deg, dh " << dh / kArcmin << " arcmin";
+          << "heading " << heading_deg << " deg, dh " << dh / kArcmin_rad << " arcmin";
       EXPECT_DOUBLE_EQ(r.distance_m, ins.norm());
       EXPECT_EQ(r.sigma_rad, 0.0);  // no covariance given
     }
@@ -87,13 +84,13 @@ TEST(DistanceHeading, SeedErrorBudget) {
     const DistanceHeading r =
         HeadingErrorFromDistance(10e3 * std::cos(psi), 10e3 * std::sin(psi), 0.0, 0.0, cov17);
     // First order is exact for the sigma at zero error (u = 0); only rounding remains.
-    EXPECT_NEAR(r.sigma_rad / kArcmin, 17.0 / 10e3 / kArcmin, 1e-9);
-    EXPECT_NEAR(r.sigma_rad / kArcmin, 5.84, 0.005);
+    EXPECT_NEAR(r.sigma_rad / kArcmin_rad, 17.0 / 10e3 / kArcmin_rad, 1e-9);
+    EXPECT_NEAR(r.sigma_rad / kArcmin_rad, 5.84, 0.005);
   }
   // The seed's accuracy estimate: 1-2 m on 8-10 km gives 0.34-0.86 arcmin ("0.4-0.9").
   const Eigen::Matrix2d cov1 = Eigen::Matrix2d::Identity();
-  EXPECT_NEAR(HeadingErrorFromDistance(10e3, 0.0, 0.0, 0.0, cov1).sigma_rad / kArcmin, 0.344, 0.001);
-  EXPECT_NEAR(HeadingErrorFromDistance(8e3, 0.0, 0.0, 0.0, 4.0 * cov1).sigma_rad / kArcmin, 0.859, 0.001);
+  EXPECT_NEAR(HeadingErrorFromDistance(10e3, 0.0, 0.0, 0.0, cov1).sigma_rad / kArcmin_rad, 0.344, 0.001);
+  EXPECT_NEAR(HeadingErrorFromDistance(8e3, 0.0, 0.0, 0.0, 4.0 * cov1).sigma_rad / kArcmin_rad, 0.859, 0.001);
   // Only the error across the track matters: along-track error changes the distance, not
   // the direction.
   Eigen::Matrix2d along = Eigen::Matrix2d::Zero();
@@ -104,7 +101,7 @@ TEST(DistanceHeading, SeedErrorBudget) {
 TEST(DistanceHeading, SigmaMatchesSampledErrors) {
   // 20' heading error on 10 km south-west, 17 m x 9 m correlated position errors: the
   // propagated sigma against the spread of 4000 sampled results.
-  const double dh = 20.0 * kArcmin;
+  const double dh = 20.0 * kArcmin_rad;
   const Eigen::Vector2d truth(-7071.0, -7071.0);
   const Eigen::Vector2d ins = RotateNe(truth, dh);
   Eigen::Matrix2d cov;
@@ -147,7 +144,7 @@ TEST(DistanceHeading, RejectsBadInput) {
 // the true one rotated by Exp(-phi_n) and its position error grows as that velocity
 // integrated.
 TEST(DistanceHeading, SignFollowsTheAttitudeErrorConvention) {
-  for (const double phi_d : {20.0 * kArcmin, -20.0 * kArcmin}) {
+  for (const double phi_d : {20.0 * kArcmin_rad, -20.0 * kArcmin_rad}) {
     const double yaw = 200.0 * kDegToRad;  // third quadrant: south-south-west
     const Eigen::Matrix3d r_true = DcmFromEuler(2.0 * kDegToRad, 3.0 * kDegToRad, yaw);
     const Eigen::Vector3d phi_n(0.0, 0.0, phi_d);
@@ -159,7 +156,7 @@ TEST(DistanceHeading, SignFollowsTheAttitudeErrorConvention) {
     ASSERT_NEAR((phi_back - phi_n).norm(), 0.0, 1e-12);
     ASSERT_NEAR(WrapPi(EulerFromDcm(r_est).z() - yaw), -phi_d, 1e-12);
 
-    const Eigen::Vector3d g_n(0.0, 0.0, kG);
+    const Eigen::Vector3d g_n(0.0, 0.0, kStandardGravity_mps2);
     const Eigen::Vector3d along_n = r_true.col(0);  // body x in NED
     const double dt = 0.01, accel = 47.6, accel_s = 5.0;
     Eigen::Vector3d v_true = Eigen::Vector3d::Zero(), v_ins = v_true;
@@ -293,7 +290,7 @@ TEST(DistanceFlown, RejectsMixedFormsAndTimeGoingBack) {
 // Schuler loop needs them, docs/inflight-alignment.md), integrated by RK4. R = g / w^2 so
 // that the model's Schuler rate is exactly w. Errors INS minus true, seed's axes.
 struct SchulerModel {
-  double w = SeparationOptions().schuler_rate_rad_s;
+  double w = SeparationOptions().schuler_rate_radps;
   Eigen::Vector2d df_ne = Eigen::Vector2d::Zero();    // accelerometer bias, m/s^2
   Eigen::Vector2d dw_ne = Eigen::Vector2d::Zero();    // gyro bias, rad/s
   Eigen::Vector2d eps0_ne = Eigen::Vector2d::Zero();  // initial tilt, rad
@@ -305,11 +302,11 @@ struct SchulerModel {
 using ErrState = Eigen::Matrix<double, 6, 1>;
 
 ErrState ErrRate(const SchulerModel& m, const ErrState& s) {
-  const double r = kG / (m.w * m.w);
+  const double r = kStandardGravity_mps2 / (m.w * m.w);
   ErrState d;
   d << s(2), s(3),
-       kG * s(5) + m.df_ne.x(),    // dV_N' = g eps_E + df_N
-       -kG * s(4) + m.df_ne.y(),   // dV_E' = -g eps_N + df_E
+       kStandardGravity_mps2 * s(5) + m.df_ne.x(),    // dV_N' = g eps_E + df_N
+       -kStandardGravity_mps2 * s(4) + m.df_ne.y(),   // dV_E' = -g eps_N + df_E
        s(3) / r + m.dw_ne.x(),     // eps_N' = dV_E / R + dw_N
        -s(2) / r + m.dw_ne.y();    // eps_E' = -dV_N / R + dw_E
   return d;
@@ -336,16 +333,16 @@ std::vector<Eigen::Vector2d> IntegrateSchuler(const SchulerModel& m, const std::
 
 // The coefficients c0..c3 that the header gives for a model.
 std::array<double, 4> ExpectedNorth(const SchulerModel& m) {
-  return {m.dp0_ne.x(), m.dv0_ne.x(), m.df_ne.x() + kG * m.eps0_ne.y(), kG * m.dw_ne.y()};
+  return {m.dp0_ne.x(), m.dv0_ne.x(), m.df_ne.x() + kStandardGravity_mps2 * m.eps0_ne.y(), kStandardGravity_mps2 * m.dw_ne.y()};
 }
 std::array<double, 4> ExpectedEast(const SchulerModel& m) {
-  return {m.dp0_ne.y(), m.dv0_ne.y(), m.df_ne.y() - kG * m.eps0_ne.x(), -kG * m.dw_ne.x()};
+  return {m.dp0_ne.y(), m.dv0_ne.y(), m.df_ne.y() - kStandardGravity_mps2 * m.eps0_ne.x(), -kStandardGravity_mps2 * m.dw_ne.x()};
 }
 
 TEST(SchulerBasis, MatchesTheIntegratedErrorModel) {
   SchulerModel m;
-  m.df_ne = Eigen::Vector2d(100.0, -70.0) * kMicroG;
-  m.dw_ne = Eigen::Vector2d(0.01, -0.02) * kDegPerHour;
+  m.df_ne = Eigen::Vector2d(100.0, -70.0) * kMicroG_mps2;
+  m.dw_ne = Eigen::Vector2d(0.01, -0.02) * kDegPerHour_radps;
   m.eps0_ne = Eigen::Vector2d(2e-5, -5e-5);
   m.dv0_ne = Eigen::Vector2d(0.1, -0.05);
   m.dp0_ne = Eigen::Vector2d(3.0, -4.0);
@@ -414,13 +411,13 @@ std::vector<DistanceErrorSample> SouthFlight(double dh, const SchulerModel& m, d
 // accelerometer bias is not cancelled by leveling: 86 m after 420 s, the worst case).
 SchulerModel SeedBiases() {
   SchulerModel m;
-  m.df_ne = Eigen::Vector2d(100.0, 100.0) * kMicroG;
-  m.dw_ne = Eigen::Vector2d(0.01, 0.01) * kDegPerHour;
+  m.df_ne = Eigen::Vector2d(100.0, 100.0) * kMicroG_mps2;
+  m.dw_ne = Eigen::Vector2d(0.01, 0.01) * kDegPerHour_radps;
   return m;
 }
 
 TEST(SeparateHeadingError, RecoversHeadingOn100KmSouthWithoutNoise) {
-  const double dh = 20.0 * kArcmin;
+  const double dh = 20.0 * kArcmin_rad;
   const SchulerModel m = SeedBiases();
   const std::vector<DistanceErrorSample> samples = SouthFlight(dh, m, 100e3, 0.0, nullptr);
   const HeadingSeparation r = SeparateHeadingError(samples);
@@ -428,12 +425,12 @@ TEST(SeparateHeadingError, RecoversHeadingOn100KmSouthWithoutNoise) {
   EXPECT_LT(r.condition_number, 1e3);
   // The basis holds the Schuler error exactly and err_E = tan(dh) dN exactly: the fit
   // returns tan dh (dh + 3e-4') up to the RK4 error; 0.01' is "well under 1'".
-  EXPECT_NEAR(r.dh_rad / kArcmin, 20.0, 0.01);
+  EXPECT_NEAR(r.dh_rad / kArcmin_rad, 20.0, 0.01);
   // Without the Schuler terms the same data give 2.1' of error (the seed's "about 1
   // arcmin, limited by the Schuler terms"): the part that must be removed is really there.
   SeparationOptions heading_only;
   heading_only.terms = {{false, false, false, false}};
-  EXPECT_GT(std::abs(SeparateHeadingError(samples, heading_only).dh_rad - dh), 1.5 * kArcmin);
+  EXPECT_GT(std::abs(SeparateHeadingError(samples, heading_only).dh_rad - dh), 1.5 * kArcmin_rad);
   // The fitted east coefficients are the biases of the model (c2 = df_E, c3 = -g dw_N);
   // the gyro term is only 6 m of signal after 420 s, hence 1 % on it.
   const std::array<double, 4> ce = ExpectedEast(m), cn = ExpectedNorth(m);
@@ -448,7 +445,7 @@ TEST(SeparateHeadingError, RecoversHeadingOn100KmSouthWithoutNoise) {
 }
 
 TEST(SeparateHeadingError, SigmaIsHonestWith17mNoise) {
-  const double dh = 20.0 * kArcmin;
+  const double dh = 20.0 * kArcmin_rad;
   const SchulerModel m = SeedBiases();
   SeparationOptions given;
   given.position_sigma_m = 17.0;
@@ -474,7 +471,7 @@ TEST(SeparateHeadingError, SigmaIsHonestWith17mNoise) {
   // About 1 arcmin at 100 km with 17 m GPS at 1 Hz: fitting offset, tilt and gyro terms
   // costs a factor 20 over the heading alone (0.05'), the price of removing the 2.1'
   // Schuler error (docs/inflight-alignment.md).
-  EXPECT_LT(sigma, 1.1 * kArcmin);
+  EXPECT_LT(sigma, 1.1 * kArcmin_rad);
   // 200 runs: the spread scatters by 1/sqrt(400) = 5 % and the mean by sigma/14; 15 % and
   // 3 sigma/sqrt(200) are 3 standard errors.
   EXPECT_NEAR(spread / sigma, 1.0, 0.15);
@@ -484,7 +481,7 @@ TEST(SeparateHeadingError, SigmaIsHonestWith17mNoise) {
 TEST(SeparateHeadingError, VelocityTermOnAStraightFlightIsDroppedWithANote) {
   // Constant speed from the start: dN(t) = -238 t, so dH dN(t) is a multiple of the
   // velocity column... with the gyro column (t = sin(x)/w + (x - sin x)/w): singular.
-  const double dh = 20.0 * kArcmin;
+  const double dh = 20.0 * kArcmin_rad;
   const SchulerModel m = SeedBiases();
   const std::vector<DistanceErrorSample> samples =
       SouthFlight(dh, m, 100e3, 0.0, nullptr, /*accel_s=*/0.0);
@@ -496,7 +493,7 @@ TEST(SeparateHeadingError, VelocityTermOnAStraightFlightIsDroppedWithANote) {
   EXPECT_TRUE(r.schuler.used[static_cast<int>(SchulerTerm::kGyro)]);
   EXPECT_LE(r.condition_number, all.max_condition);
   // The data have no initial velocity error, so the reduced fit is exact (as above).
-  EXPECT_NEAR(r.dh_rad / kArcmin, 20.0, 0.01);
+  EXPECT_NEAR(r.dh_rad / kArcmin_rad, 20.0, 0.01);
 }
 
 // Spec priors for SeedBiases (header: c2 = df - g eps0, c3 = -+ g dw) and a 17 m offset.
@@ -504,13 +501,13 @@ SeparationOptions SeedPriors() {
   SeparationOptions o;
   o.position_sigma_m = 17.0;
   o.prior_sigma[static_cast<int>(SchulerTerm::kOffset)] = 17.0;
-  o.prior_sigma[static_cast<int>(SchulerTerm::kTilt)] = 100.0 * kMicroG;
-  o.prior_sigma[static_cast<int>(SchulerTerm::kGyro)] = kG * 0.01 * kDegPerHour;
+  o.prior_sigma[static_cast<int>(SchulerTerm::kTilt)] = 100.0 * kMicroG_mps2;
+  o.prior_sigma[static_cast<int>(SchulerTerm::kGyro)] = kStandardGravity_mps2 * 0.01 * kDegPerHour_radps;
   return o;
 }
 
 TEST(SeparateHeadingError, ShortFlightNeedsPriors) {
-  const double dh = 20.0 * kArcmin;
+  const double dh = 20.0 * kArcmin_rad;
   const SchulerModel m = SeedBiases();
   sim::Rng rng(10);
   // 10 km (42 s): the Schuler error is still < 1 m, but free coefficients for it cost a
@@ -520,7 +517,7 @@ TEST(SeparateHeadingError, ShortFlightNeedsPriors) {
   free.position_sigma_m = 17.0;
   const HeadingSeparation r_free = SeparateHeadingError(SouthFlight(dh, m, 10e3, 17.0, &rng), free);
   EXPECT_LT(r_free.condition_number, 1e3);
-  EXPECT_GT(r_free.sigma_rad, 20.0 * kArcmin);
+  EXPECT_GT(r_free.sigma_rad, 20.0 * kArcmin_rad);
   EXPECT_GT(r_free.sigma_rad, 15.0 * r_free.sigma_heading_only_rad);
   // With the specification as priors the terms stay near zero and the sigma (2.9') lies
   // between the heading alone (1.5') and equation 8 on the end point (5.8'): the 17 m
@@ -535,14 +532,14 @@ TEST(SeparateHeadingError, ShortFlightNeedsPriors) {
     sigma = r.sigma_rad;
   }
   const double rms = std::sqrt(sum_sq / runs);
-  EXPECT_LT(sigma, 3.0 * kArcmin);
+  EXPECT_LT(sigma, 3.0 * kArcmin_rad);
   // The biases of the model are fixed 1-sigma values of the priors, which the MAP fit
   // shrinks towards zero: a bias of 0.16' here, part of what sigma covers, so the check
   // is on the RMS error (bias and spread): its 200-run scatter is 5 %, 15 % is 3 of those.
   EXPECT_NEAR(rms / sigma, 1.0, 0.15);
   // At 100 km the same priors still help: 0.41' against the free fit's 0.99'.
   const HeadingSeparation r_long = SeparateHeadingError(SouthFlight(dh, m, 100e3, 17.0, &rng), priors);
-  EXPECT_LT(r_long.sigma_rad, 0.5 * kArcmin);
+  EXPECT_LT(r_long.sigma_rad, 0.5 * kArcmin_rad);
   EXPECT_LT(std::abs(r_long.dh_rad - dh), 3.0 * r_long.sigma_rad);
 }
 

@@ -20,6 +20,7 @@
 #include "core/io/input_error.h"
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
+#include "core/units.h"
 #include "problems/inflight_alignment/distance_heading.h"
 #include "problems/inflight_alignment/free_ins.h"
 #include "problems/inflight_alignment/inputs.h"
@@ -27,7 +28,6 @@
 namespace navtwin::inflight {
 namespace {
 
-constexpr double kArcmin = kDegToRad / 60.0;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The preset simulated once per test binary (1-2 s), and each method run once.
@@ -102,13 +102,13 @@ void PrintTable(const FilterRun& run) {
     if (e == nullptr) {
       std::cout << "not reached";
     } else {
-      std::cout << std::fixed << std::setprecision(2) << HeadingError(e->nav) / kArcmin << " / "
-                << e->yaw_sigma_rad / kArcmin;
+      std::cout << std::fixed << std::setprecision(2) << HeadingError(e->nav) / kArcmin_rad << " / "
+                << e->yaw_sigma_rad / kArcmin_rad;
     }
   }
   const FilterEpoch& last = run.epochs.back();
   std::cout << "  end (" << std::setprecision(1) << last.path_length_m / 1e3 << " km): " << std::setprecision(2)
-            << HeadingError(last.nav) / kArcmin << " / " << last.yaw_sigma_rad / kArcmin << "; run time "
+            << HeadingError(last.nav) / kArcmin_rad << " / " << last.yaw_sigma_rad / kArcmin_rad << "; run time "
             << std::setprecision(3) << run.run_time_s << " s; " << run.gps_rejected << " fixes rejected\n";
 }
 
@@ -143,8 +143,8 @@ TEST(InflightFilter, KalmanBaselineHeadingIsWithinItsSigmaAndBelowTheSeedPlateau
   // directly, while the east gyro bias and the heading's Earth-rate coupling act
   // along-track on a flight south. Seed 1 ends at 0.66 arcmin; a filter held at the seed's
   // plateau would fail this.
-  EXPECT_LT(std::abs(end_error), 2.84 * kArcmin);
-  EXPECT_LT(last.yaw_sigma_rad, 2.84 * kArcmin);
+  EXPECT_LT(std::abs(end_error), 2.84 * kArcmin_rad);
+  EXPECT_LT(last.yaw_sigma_rad, 2.84 * kArcmin_rad);
 }
 
 TEST(InflightFilter, DistanceMethodKeepsTheHeadingUntilTheThresholdThenTakesItFromTheDistance) {
@@ -156,11 +156,11 @@ TEST(InflightFilter, DistanceMethodKeepsTheHeadingUntilTheThresholdThenTakesItFr
   const double t_first_s = run.computations.front().t_s;
   // The first computation at the first accepted fix past the threshold (path length at
   // 1 Hz and 238 m/s: within 0.25 km), then every 10 km.
-  EXPECT_GE(run.computations.front().path_length_m, config.distance.threshold_km * 1e3);
-  EXPECT_LT(run.computations.front().path_length_m, config.distance.threshold_km * 1e3 + 250.0);
+  EXPECT_GE(run.computations.front().path_length_m, config.distance.threshold_m);
+  EXPECT_LT(run.computations.front().path_length_m, config.distance.threshold_m + 250.0);
   for (std::size_t i = 1; i < run.computations.size(); ++i) {
     EXPECT_NEAR(run.computations[i].path_length_m - run.computations[i - 1].path_length_m,
-                config.distance.recompute_every_km * 1e3, 250.0);
+                config.distance.recompute_every_m, 250.0);
   }
 
   // The true heading error of the free INS at each computation (same INS, same IMU and
@@ -177,8 +177,8 @@ TEST(InflightFilter, DistanceMethodKeepsTheHeadingUntilTheThresholdThenTakesItFr
     // The computation's sigma is honest: within 3 sigma (seed 1: at most 1.5 sigma, all
     // twelve on the same side since they share the samples).
     EXPECT_LT(std::abs(c.dh_rad - dh_true), 3.0 * c.sigma_rad)
-        << "at " << c.path_length_m / 1e3 << " km: dH " << c.dh_rad / kArcmin << ", true "
-        << dh_true / kArcmin << ", sigma " << c.sigma_rad / kArcmin << " arcmin";
+        << "at " << c.path_length_m / 1e3 << " km: dH " << c.dh_rad / kArcmin_rad << ", true "
+        << dh_true / kArcmin_rad << ", sigma " << c.sigma_rad / kArcmin_rad << " arcmin";
     EXPECT_NEAR(c.correction_rad, c.dh_rad - applied_rad, 1e-12);
     applied_rad = c.dh_rad;
     EXPECT_EQ(c.separation.note, "");  // every requested term was fitted
@@ -192,20 +192,20 @@ TEST(InflightFilter, DistanceMethodKeepsTheHeadingUntilTheThresholdThenTakesItFr
       // convergence of the rotated track, 0.05 arcmin per 100 s, free_ins_test.cc) and the
       // 0.01 deg/h z gyro bias; 1 arcmin is ten times both. Its sigma stays the initial
       // 30 arcmin to 1 % (only the propagation touches it).
-      EXPECT_NEAR(error, -20.0 * kArcmin, 1.0 * kArcmin) << "t " << e.t_s;
-      EXPECT_NEAR(e.yaw_sigma_rad, config.initial.heading_arcmin * kArcmin,
-                  0.01 * config.initial.heading_arcmin * kArcmin)
+      EXPECT_NEAR(error, -20.0 * kArcmin_rad, 1.0 * kArcmin_rad) << "t " << e.t_s;
+      EXPECT_NEAR(e.yaw_sigma_rad, config.initial.heading_rad,
+                  0.01 * config.initial.heading_rad)
           << "t " << e.t_s;
     } else {
       // After the first computation: half the initial error at the very least (seed 1:
       // -1.96 arcmin at 10 km, sigma 2.98), and within 3 sigma.
-      EXPECT_LT(std::abs(error), 10.0 * kArcmin) << "t " << e.t_s;
+      EXPECT_LT(std::abs(error), 10.0 * kArcmin_rad) << "t " << e.t_s;
       EXPECT_LT(std::abs(error), 3.0 * e.yaw_sigma_rad) << "t " << e.t_s;
     }
   }
   // The end (125 km): seed 1 gives -0.52 arcmin, sigma 0.77 arcmin; 1.5 arcmin is the
   // 3 sigma of the 17 m fixes over the ~100 km of the seed's "about 1 arcmin later".
-  EXPECT_LT(std::abs(HeadingError(run.epochs.back().nav)), 1.5 * kArcmin);
+  EXPECT_LT(std::abs(HeadingError(run.epochs.back().nav)), 1.5 * kArcmin_rad);
   EXPECT_NEAR(run.epochs.back().yaw_sigma_rad, run.computations.back().sigma_rad,
               0.05 * run.computations.back().sigma_rad);  // reset to it, then propagated
 }
@@ -284,10 +284,10 @@ TEST(InflightFilter, RejectsBadInputsAndConfiguration) {
   no_gnss.gnss.clear();
   EXPECT_THROW(RunInflightFilter(no_gnss, InflightConfig{}, FilterMethod::kKalman), InputError);
   InflightConfig bad;
-  bad.distance.threshold_km = 0.0;
+  bad.distance.threshold_m = 0.0;
   EXPECT_THROW(RunInflightFilter(Preset(), bad, FilterMethod::kDistance), std::invalid_argument);
   bad = InflightConfig{};
-  bad.initial.heading_arcmin = -1.0;
+  bad.initial.heading_rad = -1.0;
   EXPECT_THROW(RunInflightFilter(Preset(), bad, FilterMethod::kKalman), std::invalid_argument);
 }
 

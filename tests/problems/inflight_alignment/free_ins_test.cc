@@ -17,14 +17,13 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/sim/scenario.h"
+#include "core/units.h"
 #include "problems/inflight_alignment/distance_heading.h"
 #include "problems/inflight_alignment/inputs.h"
 
 namespace navtwin::inflight {
 namespace {
 
-constexpr double kArcmin = kDegToRad / 60.0;
-constexpr double kG = 9.80665;
 
 // The preset with every sensor error off (IMU, GPS, barometer exact) and only the 20 arcmin
 // heading error in the initial state (no level error: its Schuler error would be 150 m
@@ -40,7 +39,7 @@ const InflightInputs& PerfectSensors() {
     sc.baro->bias_sigma_m = 0.0;
     sc.baro->noise_m = 0.0;
     sc.init_errors = sim::InitErrorConfig{};
-    sc.init_errors.attitude_phi_n_rad = Eigen::Vector3d(0.0, 0.0, 20.0 * kArcmin);
+    sc.init_errors.attitude_phi_n_rad = Eigen::Vector3d(0.0, 0.0, 20.0 * kArcmin_rad);
     return SimulateInflightInputs(sc, /*seed=*/1);
   }();
   return inputs;
@@ -65,8 +64,8 @@ TEST(InflightFreeIns, PerfectSensorsErrorIsTheRotationOfTheGainedDisplacement) {
   ASSERT_GT(epochs.size(), 500u);  // 545 s at 1 Hz
   EXPECT_DOUBLE_EQ(epochs.front().sample.t_s, epochs.front().t_s - in.initial.t_s);
 
-  const double earth_rate_cos_lat = wgs84::kOmegaIe_rad_s * std::cos(in.initial.lat_rad);
-  const double dh0 = -20.0 * kArcmin;  // the injected error: dH = -phi_D
+  const double earth_rate_cos_lat = wgs84::kOmegaIe_radps * std::cos(in.initial.lat_rad);
+  const double dh0 = -20.0 * kArcmin_rad;  // the injected error: dH = -phi_D
   const FreeInsEpoch* last_checked = nullptr;
   for (const FreeInsEpoch& e : epochs) {
     // Up to 100 s (20 km gained from rest), before the Schuler terms leave the t^3 regime
@@ -86,7 +85,7 @@ TEST(InflightFreeIns, PerfectSensorsErrorIsTheRotationOfTheGainedDisplacement) {
     // d(phi_E)/dt = Omega cos L phi_D, d(dv_N)/dt = -g phi_E, so the INS runs ahead north
     // by err_N = g Omega cos L phi_D t^3 / 6 = -g Omega cos L dH t^3 / 6 (0.56 m at 100 s;
     // the docs' gyro-shaped term).
-    predicted.x() -= kG * earth_rate_cos_lat * dh0 * t * t * t / 6.0;
+    predicted.x() -= kStandardGravity_mps2 * earth_rate_cos_lat * dh0 * t * t * t / 6.0;
     const Eigen::Vector2d err(e.sample.err_n_m, e.sample.err_e_m);
     // What remains are products of small errors through the pull-up and the speed-up
     // (attitude error times pitch rate, the vertical loop), a few centimetres (measured:
@@ -97,14 +96,14 @@ TEST(InflightFreeIns, PerfectSensorsErrorIsTheRotationOfTheGainedDisplacement) {
   }
   ASSERT_NE(last_checked, nullptr);
   const double dh_true = WrapPi(last_checked->yaw_free_rad - TruthYaw(in.truth, last_checked->t_s));
-  EXPECT_NEAR(dh_true, dh0, 0.1 * kArcmin);  // the meridian-convergence drift above
+  EXPECT_NEAR(dh_true, dh0, 0.1 * kArcmin_rad);  // the meridian-convergence drift above
   // Equation 8 on the last sample recovers it: the cross-track remainder (< 0.1 m) over
   // the 19 km gained is 0.02 arcmin; the along-track terms enter through dE err_N / D^2
   // (0.1 km x 0.6 m / (19 km)^2 = 6e-4 arcmin).
   const DistanceErrorSample& s = last_checked->sample;
   ASSERT_GT(std::hypot(s.dn_m, s.de_m), 19e3);
   const double dh_eq8 = DistanceHeadingError(s.dn_m, s.de_m, s.err_n_m, s.err_e_m);
-  EXPECT_NEAR(dh_eq8, dh_true, 0.02 * kArcmin) << "gained " << std::hypot(s.dn_m, s.de_m) << " m";
+  EXPECT_NEAR(dh_eq8, dh_true, 0.02 * kArcmin_rad) << "gained " << std::hypot(s.dn_m, s.de_m) << " m";
 }
 
 TEST(InflightFreeIns, FixBetweenImuEpochsIsComparedAtItsOwnTime) {

@@ -12,7 +12,7 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/sim/scenario.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 #include "core/sim/truth.h"
 
 namespace navtwin::inflight {
@@ -247,7 +247,7 @@ imu: {rate_hz: 100}
 )";
 
 std::vector<Eigen::Vector3d> PullUpTruth(int seconds) {
-  const sim::Scenario sc = sim::ParseScenario(sim::ParseYaml(kPullUpScenario, "pull-up test scenario"));
+  const sim::Scenario sc = sim::ParseScenario(ParseYaml(kPullUpScenario, "pull-up test scenario"));
   EXPECT_NEAR(sc.start.lat_rad, kOrigin.lat_rad, 1e-12);
   sim::TruthGenerator gen(*sc.trajectory, sc.start, 10.0);
   std::vector<Eigen::Vector3d> truth;

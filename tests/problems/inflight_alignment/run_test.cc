@@ -19,12 +19,12 @@
 
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
+#include "core/units.h"
 #include "problems/inflight_alignment/inputs.h"
 
 namespace navtwin::inflight {
 namespace {
 
-constexpr double kArcmin = kDegToRad / 60.0;
 
 NavState StateWithYaw(double t_s, double yaw_deg) {
   NavState s;
@@ -184,7 +184,7 @@ TEST_P(InflightRunPresetTest, ErrorsAtEveryDistanceAreFiniteAndSmallerThanTheIni
   // The INS starts 20' off in heading. Even the Kalman-only baseline, the weakest method,
   // ends within its ~3' plateau (seed 003); 10' is a bound that only a sign or wrap error
   // (a heading south compared the long way round) or a diverged estimator would break.
-  EXPECT_LT(std::abs(r.final_error_rad), 10.0 * kArcmin) << r.final_error_rad / kArcmin << "'";
+  EXPECT_LT(std::abs(r.final_error_rad), 10.0 * kArcmin_rad) << r.final_error_rad / kArcmin_rad << "'";
   EXPECT_GT(r.final_sigma_rad, 0.0);
   EXPECT_EQ(r.final_error_rad, r.track.back().error_rad);
   EXPECT_GT(r.run_time_s, 0.0);
@@ -217,7 +217,7 @@ TEST_P(InflightRunPresetTest, JsonHasTheIssuesKeysAndParses) {
   // The final error in the JSON is the result's, in arcmin (10 significant digits).
   std::smatch m;
   ASSERT_TRUE(std::regex_search(json, m, std::regex("\"final_heading_error_arcmin\":(-?[0-9.eE+-]+)")));
-  EXPECT_NEAR(std::stod(m[1]), r.final_error_rad / kArcmin, 1e-8 * std::max(1.0, std::abs(r.final_error_rad / kArcmin)));
+  EXPECT_NEAR(std::stod(m[1]), r.final_error_rad / kArcmin_rad, 1e-8 * std::max(1.0, std::abs(r.final_error_rad / kArcmin_rad)));
   if (r.method == Method::kBatch) {
     EXPECT_NE(json.find("\"batch\":{\"dh_arcmin\":"), std::string::npos);
   }
@@ -247,7 +247,7 @@ TEST_P(InflightRunPresetTest, TrackCsvHasOneRowPerFix) {
   EXPECT_EQ(rows, r.track.size());
   // The last row is the final error, written in the shortest exact form (1e-12 relative:
   // rad -> arcmin scaled by kRadToDeg * 60 there, by 1 / (kDegToRad / 60) here).
-  EXPECT_NEAR(err, r.final_error_rad / kArcmin, 1e-12 * std::abs(r.final_error_rad / kArcmin));
+  EXPECT_NEAR(err, r.final_error_rad / kArcmin_rad, 1e-12 * std::abs(r.final_error_rad / kArcmin_rad));
   std::remove(path.c_str());
 }
 

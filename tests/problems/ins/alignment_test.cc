@@ -8,11 +8,11 @@
 
 #include "core/earth.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 namespace navtwin::ins {
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 // Exact increments of an IMU at rest on the Earth at latitude lat, height 0, attitude R:
 // omega_b = R^T omega_ie_n, f_b = -R^T g_n (specific force points up, f_z ~ -g when
@@ -44,8 +44,8 @@ struct Attitude { double roll, pitch, yaw; };
 
 // Attitudes in every quadrant of roll and yaw, both pitch signs, up to 170 deg roll.
 const Attitude kAttitudes[] = {
-    {0.0, 0.0, 0.0},           {5 * kDeg, -3 * kDeg, 30 * kDeg},  {-20 * kDeg, 10 * kDeg, -120 * kDeg},
-    {100 * kDeg, 40 * kDeg, 175 * kDeg}, {-170 * kDeg, -60 * kDeg, -60 * kDeg}, {45 * kDeg, 80 * kDeg, 91 * kDeg},
+    {0.0, 0.0, 0.0},           {5 * kDegToRad, -3 * kDegToRad, 30 * kDegToRad},  {-20 * kDegToRad, 10 * kDegToRad, -120 * kDegToRad},
+    {100 * kDegToRad, 40 * kDegToRad, 175 * kDegToRad}, {-170 * kDegToRad, -60 * kDegToRad, -60 * kDegToRad}, {45 * kDegToRad, 80 * kDegToRad, 91 * kDegToRad},
 };
 
 // The Euler angles of the result vs the truth; the comparison through the rotation
@@ -53,31 +53,31 @@ const Attitude kAttitudes[] = {
 // in roll/pitch; the gyrocompass heading is a ratio of Earth-rate components of 5e-5 rad/s
 // computed from sums of 1000 samples, still ~1e-12. Tolerance 1e-9 as required.
 TEST(StaticCoarseAlignment, GyrocompassingRecoversKnownAttitudes) {
-  const double lat = 47.0 * kDeg;
+  const double lat = 47.0 * kDegToRad;
   for (const Attitude& a : kAttitudes) {
     const Eigen::Matrix3d R = DcmFromEuler(a.roll, a.pitch, a.yaw);
     const Eigen::Quaterniond q = StaticCoarseAlignment(StaticSamples(R, lat, 10.0), lat, std::nullopt, 0.0);
     const Eigen::Vector3d e = EulerFromQuat(q);
-    EXPECT_NEAR(e.x(), a.roll, 1e-9) << a.roll / kDeg << " " << a.pitch / kDeg << " " << a.yaw / kDeg;
+    EXPECT_NEAR(e.x(), a.roll, 1e-9) << a.roll / kDegToRad << " " << a.pitch / kDegToRad << " " << a.yaw / kDegToRad;
     EXPECT_NEAR(e.y(), a.pitch, 1e-9);
     EXPECT_LT(AttitudeError(QuatFromEuler(a.roll, a.pitch, a.yaw), q).norm(), 1e-9);
   }
 }
 
 TEST(StaticCoarseAlignment, MagnetometerHeadingWithDeclination) {
-  const double lat = -33.0 * kDeg, declination = -11.0 * kDeg;
-  for (double inclination : {-55.0 * kDeg, 65.0 * kDeg}) {
+  const double lat = -33.0 * kDegToRad, declination = -11.0 * kDegToRad;
+  for (double inclination : {-55.0 * kDegToRad, 65.0 * kDegToRad}) {
     for (const Attitude& a : kAttitudes) {
       const Eigen::Matrix3d R = DcmFromEuler(a.roll, a.pitch, a.yaw);
       const Eigen::Vector3d m_b = R.transpose() * FieldNed(declination, inclination);
       const Eigen::Quaterniond q = StaticCoarseAlignment(StaticSamples(R, lat, 2.0), lat, m_b, declination);
       EXPECT_LT(AttitudeError(QuatFromEuler(a.roll, a.pitch, a.yaw), q).norm(), 1e-9)
-          << a.roll / kDeg << " " << a.pitch / kDeg << " " << a.yaw / kDeg;
+          << a.roll / kDegToRad << " " << a.pitch / kDegToRad << " " << a.yaw / kDegToRad;
     }
   }
   // Without the declination the heading is off by exactly the declination.
   const Eigen::Matrix3d R = DcmFromEuler(0.1, -0.05, 1.0);
-  const Eigen::Vector3d m_b = R.transpose() * FieldNed(declination, 60 * kDeg);
+  const Eigen::Vector3d m_b = R.transpose() * FieldNed(declination, 60 * kDegToRad);
   const Eigen::Quaterniond q = StaticCoarseAlignment(StaticSamples(R, lat, 1.0), lat, m_b, 0.0);
   EXPECT_NEAR(EulerFromQuat(q).z(), 1.0 - declination, 1e-12);
 }
@@ -85,13 +85,13 @@ TEST(StaticCoarseAlignment, MagnetometerHeadingWithDeclination) {
 TEST(StaticCoarseAlignment, SignsOfLevelingFromSpecificForce) {
   // Nose up 10 deg: the accelerometer x axis senses +g sin(10 deg) (f_b ~ -g_b at rest).
   const double lat = 0.5;
-  const auto samples = StaticSamples(DcmFromEuler(0.0, 10 * kDeg, 0.0), lat, 1.0);
+  const auto samples = StaticSamples(DcmFromEuler(0.0, 10 * kDegToRad, 0.0), lat, 1.0);
   EXPECT_GT(samples[0].dv_b_mps.x(), 0.0);
-  EXPECT_NEAR(EulerFromQuat(StaticCoarseAlignment(samples, lat, std::nullopt, 0.0)).y(), 10 * kDeg, 1e-12);
+  EXPECT_NEAR(EulerFromQuat(StaticCoarseAlignment(samples, lat, std::nullopt, 0.0)).y(), 10 * kDegToRad, 1e-12);
   // Right wing down 10 deg: f_y = -g cos(p) sin(r) < 0 and the result is roll = +10 deg.
-  const auto rolled = StaticSamples(DcmFromEuler(10 * kDeg, 0.0, 0.0), lat, 1.0);
+  const auto rolled = StaticSamples(DcmFromEuler(10 * kDegToRad, 0.0, 0.0), lat, 1.0);
   EXPECT_LT(rolled[0].dv_b_mps.y(), 0.0);
-  EXPECT_NEAR(EulerFromQuat(StaticCoarseAlignment(rolled, lat, std::nullopt, 0.0)).x(), 10 * kDeg, 1e-12);
+  EXPECT_NEAR(EulerFromQuat(StaticCoarseAlignment(rolled, lat, std::nullopt, 0.0)).x(), 10 * kDegToRad, 1e-12);
 }
 
 TEST(StaticCoarseAlignment, RejectsEmptyAndMovingData) {
@@ -115,7 +115,7 @@ TEST(AttitudeFromGnssVelocity, LevelWithVelocityHeading) {
   EXPECT_NEAR(e.y(), 0.0, 1e-15);
   EXPECT_NEAR(e.z(), std::atan2(-4.0, -3.0), 1e-15);
   // East: heading +90 deg.
-  EXPECT_NEAR(EulerFromQuat(AttitudeFromGnssVelocity(Eigen::Vector3d(0.0, 5.0, 0.0))).z(), 90 * kDeg, 1e-15);
+  EXPECT_NEAR(EulerFromQuat(AttitudeFromGnssVelocity(Eigen::Vector3d(0.0, 5.0, 0.0))).z(), 90 * kDegToRad, 1e-15);
   EXPECT_THROW(AttitudeFromGnssVelocity(Eigen::Vector3d(0.0, 0.0, 3.0)), std::invalid_argument);
 }
 

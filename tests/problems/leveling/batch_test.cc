@@ -19,7 +19,6 @@
 
 namespace navtwin::leveling {
 namespace {
-
 using namespace test_windows;
 
 // The seed's vibration: body x, 1 g, random phase.
@@ -34,7 +33,6 @@ Truth SeedTruth(sim::Rng& rng, double roll_deg = 0.0, double pitch_deg = 0.0) {
 // The white-noise floor of the pitch (and of the roll at pitch 0): sigma / (g sqrt(N)).
 double Floor(double noise_mps2 = kNoise) { return noise_mps2 / (kG * std::sqrt(kSamples)); }
 
-double WrapPi(double a) { return std::remainder(a, 2.0 * kPi); }
 
 TEST(LevelingBatchTest, TiltedWindowWithinItsSigmaNearTheNoiseFloor) {
   sim::Rng rng(101);

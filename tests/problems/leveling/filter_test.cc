@@ -10,6 +10,7 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/leveling_model.h"
+#include "core/units.h"
 #include "problems/leveling/monte_carlo.h"
 #include "tests/problems/leveling/simulated_window.h"
 
@@ -17,7 +18,6 @@ namespace navtwin::leveling {
 namespace {
 
 constexpr double kG = kStandardGravity_mps2;
-constexpr double kPi = 3.141592653589793;
 constexpr double kRate_hz = 600.0;
 constexpr int kSamples = 120;  // 0.2 s at 600 Hz: the seed's window
 

@@ -9,13 +9,13 @@
 #include "core/rotation.h"
 #include "core/sim/random.h"
 #include "core/leveling_model.h"
+#include "core/units.h"
 #include "problems/leveling/monte_carlo.h"
 
 namespace navtwin::leveling {
 namespace {
 
 constexpr double kG = kStandardGravity_mps2;
-constexpr double kPi = 3.141592653589793;
 
 TEST(LevelingTest, NoiseEstimateIgnoresTheVibration) {
   MonteCarloConfig seed_experiment;  // the seed's draws (problems/leveling/monte_carlo.h)

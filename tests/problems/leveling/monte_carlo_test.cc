@@ -11,12 +11,12 @@
 
 #include "core/rotation.h"
 #include "core/leveling_model.h"
+#include "core/units.h"
 
 namespace navtwin::leveling {
 namespace {
 
 constexpr double kG = kStandardGravity_mps2;
-constexpr double kPi = 3.141592653589793;
 
 // Sample mean and standard deviation.
 struct Moments {
@@ -59,7 +59,7 @@ TEST(LevelingMonteCarloTest, WindowHasTheConfiguredSamplesAndTimes) {
   EXPECT_EQ(w.t_s[0], 0.0);
   EXPECT_DOUBLE_EQ(w.t_s[119], 119.0 / 600.0);
   EXPECT_EQ(w.rate_hz, 600.0);
-  EXPECT_TRUE(w.omega_b_rad_s.empty());
+  EXPECT_TRUE(w.omega_b_radps.empty());
   c.window_s = 0.1;
   c.rate_hz = 1000.0;
   EXPECT_EQ(SimulateWindow(c, 0).size(), 100);

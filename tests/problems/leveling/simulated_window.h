@@ -12,12 +12,12 @@
 
 #include "core/leveling_model.h"
 #include "core/sim/random.h"
+#include "core/units.h"
 #include "problems/leveling/leveling.h"
 
 namespace navtwin::leveling::test_windows {
 
 constexpr double kG = kStandardGravity_mps2;
-constexpr double kPi = 3.141592653589793;
 constexpr double kNoise = 0.05 * kG;  // 50 mg
 constexpr int kSamples = 120;
 constexpr double kRate = 600.0;

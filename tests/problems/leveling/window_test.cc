@@ -16,12 +16,12 @@
 #include "core/sim/random.h"
 #include "problems/leveling/leveling.h"
 #include "core/leveling_model.h"
+#include "core/units.h"
 
 namespace navtwin::leveling {
 namespace {
 
 constexpr double kG = kStandardGravity_mps2;
-constexpr double kPi = 3.141592653589793;
 
 using VectorOfTime = std::function<Eigen::Vector3d(double t_s)>;
 
@@ -72,7 +72,7 @@ TEST_F(WindowFileTest, ReadsTheSamplesOfTheWindowCountedFromTheFirstSample) {
   // [1.0, 1.5) s after the first sample at 100 Hz: samples 100..149.
   ASSERT_EQ(w.size(), 50);
   ASSERT_EQ(w.t_s.size(), 50u);
-  ASSERT_EQ(w.omega_b_rad_s.size(), 50u);
+  ASSERT_EQ(w.omega_b_radps.size(), 50u);
   EXPECT_EQ(w.source, path);
   // 17-digit text and a division by dt: rounding only.
   EXPECT_NEAR(w.t_s.front(), 1001.0, 1e-9);
@@ -80,7 +80,7 @@ TEST_F(WindowFileTest, ReadsTheSamplesOfTheWindowCountedFromTheFirstSample) {
   EXPECT_NEAR(w.rate_hz, 100.0, 1e-6);
   for (int k = 0; k < w.size(); ++k) {
     EXPECT_NEAR((w.f_b_mps2[k] - f(w.t_s[k])).norm(), 0.0, 1e-9);
-    EXPECT_NEAR((w.omega_b_rad_s[k] - omega(w.t_s[k])).norm(), 0.0, 1e-9);
+    EXPECT_NEAR((w.omega_b_radps[k] - omega(w.t_s[k])).norm(), 0.0, 1e-9);
   }
 }
 
@@ -163,7 +163,7 @@ AccelWindow RestingWindow(sim::Rng& rng, int n, double amplitude_mps2, double fr
     f.x() += amplitude_mps2 * std::sin(2.0 * kPi * freq_hz * t + 0.7);
     w.t_s.push_back(t);
     w.f_b_mps2.push_back(f);
-    w.omega_b_rad_s.push_back(rng.Normal3(0.02));  // gyro noise, zero mean
+    w.omega_b_radps.push_back(rng.Normal3(0.02));  // gyro noise, zero mean
   }
   return w;
 }
@@ -230,7 +230,7 @@ TEST(CheckWindowTest, QuietQuantisedOrConstantAxesAreNotClipping) {
 TEST(CheckWindowTest, RotationIsMotion) {
   sim::Rng rng(11);
   AccelWindow w = RestingWindow(rng, 120, 0.5 * kG);
-  for (Eigen::Vector3d& omega : w.omega_b_rad_s) omega.z() += 0.1;  // a 5.7 deg/s turn
+  for (Eigen::Vector3d& omega : w.omega_b_radps) omega.z() += 0.1;  // a 5.7 deg/s turn
   const WindowCheck check = CheckWindow(w, LevelingOptions());
   EXPECT_TRUE(check.moving);
   EXPECT_NE(check.message.find("moving: mean angular rate"), std::string::npos) << check.message;
@@ -239,7 +239,7 @@ TEST(CheckWindowTest, RotationIsMotion) {
 TEST(CheckWindowTest, SpecificForceAwayFromGravityIsMotionEvenWithoutGyros) {
   sim::Rng rng(12);
   AccelWindow w = RestingWindow(rng, 120, 0.5 * kG);
-  w.omega_b_rad_s.clear();  // gyros unknown
+  w.omega_b_radps.clear();  // gyros unknown
   // Accelerating forward at 5 m/s^2: |f| = 10.87 m/s^2. (A horizontal acceleration a
   // changes |f| by only about a^2 / 2g, so the 0.5 m/s^2 limit catches a >~ 3.2 m/s^2.)
   for (Eigen::Vector3d& f : w.f_b_mps2) f.x() += 5.0;

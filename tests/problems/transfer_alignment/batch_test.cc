@@ -14,7 +14,8 @@
 
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
+#include "core/units.h"
 #include "problems/transfer_alignment/filter.h"
 #include "problems/transfer_alignment/run.h"
 
@@ -48,7 +49,7 @@ init_errors: {velocity_ned_mps: [0.5, -0.5, 0.2], attitude_deg: [0.5, -0.5, 1.0]
 
 const TransferInputs& ShortInputs() {
   static const TransferInputs in =
-      SimulateTransferInputs(sim::ParseScenario(sim::ParseYaml(kShortScenario, "batch_test.cc")), 1);
+      SimulateTransferInputs(sim::ParseScenario(ParseYaml(kShortScenario, "batch_test.cc")), 1);
   return in;
 }
 
@@ -107,7 +108,7 @@ void CheckBatch(const TransferInputs& in, const char* label) {
   // that angle (the preset with them set to zero, seed 1: |mu| <= 0.029 mrad = 1.1 sigma;
   // with them: 0.070 mrad on pitch = 3.7 sigma; docs/transfer-alignment-batch.md). So the
   // bound is 3 sigma and that angle added in quadrature.
-  constexpr double kUnmodelledAxisMisalignment_rad = 20.0 / 3600.0 * M_PI / 180.0;
+  constexpr double kUnmodelledAxisMisalignment_rad = 20.0 * kArcsec_rad;
   for (int i = 0; i < 3; ++i) {
     const double sigma = sol.misalignment_sigma_rad[i];
     std::printf("misalignment axis %d: |error| = %.2f sigma\n", i, std::abs(mu_rad[i]) / sigma);

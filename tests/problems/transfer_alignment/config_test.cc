@@ -33,16 +33,16 @@ batch_max_iterations: 12
 
 TEST(TransferConfigTest, EveryKeyIsRead) {
   const TransferConfig c = ParseTransferConfig(kEveryKey, "every.yaml");
-  EXPECT_EQ(c.gyro_bias_deg_h, 2.5);
-  EXPECT_EQ(c.gyro_arw_deg_sqrt_h, 0.07);
-  EXPECT_EQ(c.accel_bias_ug, 150.0);
-  EXPECT_EQ(c.accel_vrw_m_s_sqrt_h, 0.03);
+  EXPECT_EQ(c.gyro_bias_radps, 2.5 * kDegPerHour_radps);
+  EXPECT_EQ(c.gyro_arw_rad_per_sqrt_s, 0.07 * kDegPerSqrtHour_radpsqrts);
+  EXPECT_EQ(c.accel_bias_mps2, 150.0 * kMicroG_mps2);
+  EXPECT_EQ(c.accel_vrw_mps_per_sqrt_s, 0.03 * kMpsPerSqrtHour_mpspsqrts);
   EXPECT_EQ(c.initial_velocity_mps, 0.8);
-  EXPECT_EQ(c.initial_attitude_deg, 1.5);
-  EXPECT_EQ(c.misalignment_deg, 3.0);
+  EXPECT_EQ(c.initial_attitude_rad, 1.5 * kDegToRad);
+  EXPECT_EQ(c.misalignment_rad, 3.0 * kDegToRad);
   EXPECT_EQ(c.delay_s, 0.25);
   EXPECT_EQ(c.delay_initial_s, 0.1);
-  EXPECT_EQ(c.master_attitude_mrad, 0.2);
+  EXPECT_EQ(c.master_attitude_rad, 0.2 * kMrad_rad);
   EXPECT_EQ(c.master_velocity_mps, 0.02);
   EXPECT_EQ(c.lever_arm_b_m, Eigen::Vector3d(1.5, -0.5, 0.25));
   EXPECT_EQ(c.settle_s, 0.0);  // 0 is allowed: score from the start
@@ -53,9 +53,9 @@ TEST(TransferConfigTest, EveryKeyIsRead) {
 TEST(TransferConfigTest, EmptyTextGivesTheDefaults) {
   const TransferConfig c = ParseTransferConfig("", "empty.yaml");
   const TransferConfig d;
-  EXPECT_EQ(c.gyro_bias_deg_h, d.gyro_bias_deg_h);
+  EXPECT_EQ(c.gyro_bias_radps, d.gyro_bias_radps);
   EXPECT_EQ(c.delay_s, d.delay_s);
-  EXPECT_EQ(c.master_attitude_mrad, d.master_attitude_mrad);
+  EXPECT_EQ(c.master_attitude_rad, d.master_attitude_rad);
   EXPECT_EQ(c.lever_arm_b_m, d.lever_arm_b_m);
   EXPECT_EQ(c.settle_s, d.settle_s);
   EXPECT_EQ(c.batch_max_iterations, d.batch_max_iterations);
@@ -65,16 +65,16 @@ TEST(TransferConfigTest, ShippedPresetFileListsEveryKeyWithTheDefaults) {
   const std::string path = std::string(NAVTWIN_SOURCE_DIR) + "/data/configs/transfer-alignment-high-maneuver.yaml";
   const TransferConfig c = LoadTransferConfig(path);
   const TransferConfig d;
-  EXPECT_EQ(c.gyro_bias_deg_h, d.gyro_bias_deg_h);
-  EXPECT_EQ(c.gyro_arw_deg_sqrt_h, d.gyro_arw_deg_sqrt_h);
-  EXPECT_EQ(c.accel_bias_ug, d.accel_bias_ug);
-  EXPECT_EQ(c.accel_vrw_m_s_sqrt_h, d.accel_vrw_m_s_sqrt_h);
+  EXPECT_EQ(c.gyro_bias_radps, d.gyro_bias_radps);
+  EXPECT_EQ(c.gyro_arw_rad_per_sqrt_s, d.gyro_arw_rad_per_sqrt_s);
+  EXPECT_EQ(c.accel_bias_mps2, d.accel_bias_mps2);
+  EXPECT_EQ(c.accel_vrw_mps_per_sqrt_s, d.accel_vrw_mps_per_sqrt_s);
   EXPECT_EQ(c.initial_velocity_mps, d.initial_velocity_mps);
-  EXPECT_EQ(c.initial_attitude_deg, d.initial_attitude_deg);
-  EXPECT_EQ(c.misalignment_deg, d.misalignment_deg);
+  EXPECT_EQ(c.initial_attitude_rad, d.initial_attitude_rad);
+  EXPECT_EQ(c.misalignment_rad, d.misalignment_rad);
   EXPECT_EQ(c.delay_s, d.delay_s);
   EXPECT_EQ(c.delay_initial_s, d.delay_initial_s);
-  EXPECT_EQ(c.master_attitude_mrad, d.master_attitude_mrad);
+  EXPECT_EQ(c.master_attitude_rad, d.master_attitude_rad);
   EXPECT_EQ(c.master_velocity_mps, d.master_velocity_mps);
   EXPECT_EQ(c.lever_arm_b_m, d.lever_arm_b_m);
   EXPECT_EQ(c.settle_s, d.settle_s);

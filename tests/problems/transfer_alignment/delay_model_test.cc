@@ -1,12 +1,12 @@
 // The analytic Jacobian of the transfer-alignment matching residuals (filter.h,
-// MatchResidualAndJacobian) against ceres::Jet autodiff of the core/transfer_delay_model.h residuals.
+// MatchResidualAndJacobian) against ceres::Jet autodiff of the problems/transfer_alignment/delay_model.h residuals.
 #include <random>
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
 #include "core/rotation.h"
-#include "core/transfer_delay_model.h"
+#include "problems/transfer_alignment/delay_model.h"
 #include "problems/transfer_alignment/filter.h"
 
 namespace navtwin::transfer {

@@ -67,7 +67,7 @@ TEST(TransferFilter, EpochsAndCovariance) {
 
 TEST(TransferFilter, RejectsABadConfiguration) {
   TransferConfig cfg;
-  cfg.master_attitude_mrad = 0.0;
+  cfg.master_attitude_rad = 0.0;
   EXPECT_THROW(RunTransferFilter(PresetInputs(), cfg, DelayOrder::kFirst), std::invalid_argument);
 }
 

@@ -15,13 +15,13 @@
 #include "core/io/input_error.h"
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
+#include "core/units.h"
 #include "problems/transfer_alignment/inputs.h"
 
 namespace navtwin::transfer {
 namespace {
 
-constexpr double kMrad = 1e-3;
 
 NavState StateAt(double t_s, const Eigen::Vector3d& euler_rad) {
   NavState s;
@@ -69,7 +69,7 @@ TEST(TransferRunTest, ScoringRecoversAKnownEulerErrorAcrossSouth) {
     const Eigen::Quaterniond q_true_s = in.truth[i].q_n_b.slerp(w, in.truth[i + 1].q_n_b) * M;
     const Eigen::Vector3d e_true = EulerFromQuat(q_true_s);
     const Eigen::Vector3d offset =
-        t < 2.0 ? Eigen::Vector3d(20.0, 20.0, 20.0) * kMrad : Eigen::Vector3d(1.0, -2.0, 3.0) * kMrad;
+        t < 2.0 ? Eigen::Vector3d(20.0, 20.0, 20.0) * kMrad_rad : Eigen::Vector3d(1.0, -2.0, 3.0) * kMrad_rad;
     NavState s = StateAt(t, Eigen::Vector3d(e_true.x() + offset.x(), e_true.y() + offset.y(),
                                             WrapPi(e_true.z() + offset.z())));
     est.push_back(s);
@@ -97,7 +97,7 @@ TEST(TransferRunTest, ScoringWithoutTheTrueMountingUsesTheBodyEstimate) {
   std::vector<NavState> est;
   for (int k = 0; k <= 1000; k += 2) {
     NavState s = in.truth[k];
-    s.q_n_b = ApplyAttitudeError<double>(Eigen::Vector3d(-2.0 * kMrad, 0.0, 0.0), in.truth[k].q_n_b) * M;
+    s.q_n_b = ApplyAttitudeError<double>(Eigen::Vector3d(-2.0 * kMrad_rad, 0.0, 0.0), in.truth[k].q_n_b) * M;
     est.push_back(s);
   }
   TransferResult r;
@@ -180,7 +180,7 @@ master:
   velocity_noise_mps: 0.01
 init_errors: {velocity_ned_mps: [0.5, -0.5, 0.2], attitude_deg: [0.5, -0.5, 1.0]}
 )";
-    return SimulateTransferInputs(sim::ParseScenario(sim::ParseYaml(yaml, "transfer-short.yaml")), 1, 0.12);
+    return SimulateTransferInputs(sim::ParseScenario(ParseYaml(yaml, "transfer-short.yaml")), 1, 0.12);
   }();
   return in;
 }

@@ -1,7 +1,7 @@
-// The multi-position calibration residuals (factors/imu_calibration_residuals.h): the
+// The multi-position calibration residuals (problems/calibration/imu_calibration_residuals.h): the
 // analytic Jacobian of GyroMoveCost against autodiff of GyroMoveResidual, and the zero
 // residuals at the true parameters.
-#include "factors/imu_calibration_residuals.h"
+#include "problems/calibration/imu_calibration_residuals.h"
 
 #include <cmath>
 
@@ -10,7 +10,7 @@
 
 #include "core/sim/random.h"
 
-namespace navtwin {
+namespace navtwin::calibration {
 namespace {
 
 using J12 = Eigen::Matrix<double, 3, kTriadParameters, Eigen::RowMajor>;
@@ -80,4 +80,4 @@ TEST(StaticResidualsTest, ZeroAtTheTrueParameters) {
 }
 
 }  // namespace
-}  // namespace navtwin
+}  // namespace navtwin::calibration

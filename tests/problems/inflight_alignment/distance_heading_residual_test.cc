@@ -1,9 +1,9 @@
 // DistanceHeadingResidual, DistanceHeadingTiltWalkResidual and VectorPrior2
-// (factors/distance_heading_residual.h): the Jacobians against central differences at
+// (problems/inflight_alignment/distance_heading_residual.h): the Jacobians against central differences at
 // zero, a tiny perturbation and a random point, a zero residual for data made by the model
 // (rotation built independently with Eigen::Rotation2D), the first-order (equation 8) form
 // at small heading errors, the level steps' sign and linearity, and the constructors' checks.
-#include "factors/distance_heading_residual.h"
+#include "problems/inflight_alignment/distance_heading_residual.h"
 
 #include <cmath>
 #include <cstdint>
@@ -18,14 +18,14 @@
 #include <gtest/gtest.h>
 
 #include "tests/factors/tangent_jacobian_check.h"
+#include "core/units.h"
 
-namespace navtwin {
+namespace navtwin::inflight {
 namespace {
 
 using tangent_check::Block;
 using tangent_check::ExpectTangentJacobiansMatch;
 
-constexpr double kArcmin = M_PI / (180.0 * 60.0);
 constexpr double kG = 9.80;
 constexpr double kSigma = 17.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -105,7 +105,7 @@ TEST(DistanceHeadingResidual, JacobianMatchesCentralDifferences) {
 
 TEST(DistanceHeadingResidual, ZeroForDataFromTheModel) {
   for (const auto& [name, u] : Points()) {
-    for (const double dh : {u.dh, 20.0 * kArcmin, -M_PI / 2.0, 3.0}) {
+    for (const double dh : {u.dh, 20.0 * kArcmin_rad, -M_PI / 2.0, 3.0}) {
       SCOPED_TRACE(name + " dh " + std::to_string(dh));
       Unknowns truth = u;
       truth.dh = dh;
@@ -130,8 +130,8 @@ TEST(DistanceHeadingResidual, SmallHeadingGivesTheLinearFormToSecondOrder) {
   // -(sin dH - dH) D_N - (cos dH - 1) D_E = dH^3/6 D_N + dH^2/2 D_E: O(dH^2).
   Unknowns u = Points()[2].second;
   double previous = 0.0;
-  for (const double dh : {20.0 * kArcmin, 10.0 * kArcmin, 5.0 * kArcmin}) {
-    SCOPED_TRACE(dh / kArcmin);
+  for (const double dh : {20.0 * kArcmin_rad, 10.0 * kArcmin_rad, 5.0 * kArcmin_rad}) {
+    SCOPED_TRACE(dh / kArcmin_rad);
     u.dh = dh;
     const std::unique_ptr<ceres::CostFunction> f(
         DistanceHeadingResidual::Create(kB1, kB2, kB3, kGained, kError, kSigma, kG));
@@ -291,4 +291,4 @@ TEST(VectorPrior2, ResidualJacobianAndChecks) {
 }
 
 }  // namespace
-}  // namespace navtwin
+}  // namespace navtwin::inflight

@@ -24,7 +24,7 @@
 #include <ceres/autodiff_cost_function.h>
 #include <Eigen/Core>
 
-namespace navtwin {
+namespace navtwin::calibration {
 
 class MagEllipsoid {
  public:
@@ -73,4 +73,4 @@ class MagEllipsoid {
   double inv_sigma_;
 };
 
-}  // namespace navtwin
+}  // namespace navtwin::calibration

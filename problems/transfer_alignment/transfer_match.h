@@ -1,7 +1,7 @@
 // The transfer-alignment matching residual of one master record (seed 002, issue 6), for
 // the batch (problems/transfer_alignment/batch.cc): the slave's attitude and velocity
 // against the master's, carried forward over the delay by the model shared with the
-// filter, core/transfer_delay_model.h (AttitudeMatchResidual,
+// filter, problems/transfer_alignment/delay_model.h (AttitudeMatchResidual,
 // VelocityMatchResidual; no maths of its own here).
 //
 // Frames: n = NED, b = master body FRD, s = slave IMU axes; misalignment M = R_b_s.
@@ -34,9 +34,9 @@
 #include <Eigen/Geometry>
 
 #include "core/rotation.h"
-#include "core/transfer_delay_model.h"
+#include "problems/transfer_alignment/delay_model.h"
 
-namespace navtwin {
+namespace navtwin::transfer {
 
 class TransferMatch {
  public:
@@ -99,4 +99,4 @@ class TransferMatch {
   double inv_sigma_vel_ = 0.0;
 };
 
-}  // namespace navtwin
+}  // namespace navtwin::transfer

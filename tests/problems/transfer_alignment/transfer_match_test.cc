@@ -1,9 +1,9 @@
-// TransferMatch (factors/transfer_match.h): zero residual at the truth of a master in
+// TransferMatch (problems/transfer_alignment/transfer_match.h): zero residual at the truth of a master in
 // uniform rotation and acceleration (where the delay series is exact), the meaning of the
 // delay and misalignment derivatives, tangent-space Jacobians (AutoDiff through Linearize)
 // against central differences at zero, a tiny perturbation and a random point, and the
 // constructor's checks.
-#include "factors/transfer_match.h"
+#include "problems/transfer_alignment/transfer_match.h"
 
 #include <cmath>
 #include <limits>
@@ -19,7 +19,7 @@
 #include "solvers/linearize.h"
 #include "tests/factors/tangent_jacobian_check.h"
 
-namespace navtwin {
+namespace navtwin::transfer {
 namespace {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
@@ -175,4 +175,4 @@ TEST(TransferMatch, RejectsBadArguments) {
 }
 
 }  // namespace
-}  // namespace navtwin
+}  // namespace navtwin::transfer

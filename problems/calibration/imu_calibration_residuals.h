@@ -21,7 +21,7 @@
 //      dphi_k = (I + [u_{k-1}]x / 12) du_k - [u_k]x / 12 du_{k-1}
 //      du_k = -K_g^-1 B_k dp,  B_k = d(K_g u_k + G dv_k + b_g dt_k)/dp at fixed u_k
 //      dr = Jr^-1(r) eps / sigma
-//    tests/factors/imu_calibration_residuals_test.cc checks it against autodiff of
+//    tests/problems/calibration/imu_calibration_residuals_test.cc checks it against autodiff of
 //    GyroMoveResidual.
 #pragma once
 
@@ -38,7 +38,7 @@
 #include "core/rotation.h"
 #include "core/types.h"
 
-namespace navtwin {
+namespace navtwin::calibration {
 
 class StaticAccelResidual {
  public:
@@ -64,10 +64,10 @@ class StaticAccelResidual {
 class StaticGyroResidual {
  public:
   StaticGyroResidual(const Eigen::Vector3d& omega_true_b, const Eigen::Vector3d& f_true_b,
-                     const Eigen::Vector3d& omega_mean_b, const Eigen::Vector3d& sigma_rad_s)
+                     const Eigen::Vector3d& omega_mean_b, const Eigen::Vector3d& sigma_radps)
       : omega_true_b_(omega_true_b), f_true_b_(f_true_b), omega_mean_b_(omega_mean_b),
-        inv_sigma_(sigma_rad_s.cwiseInverse()) {
-    if (!(sigma_rad_s.minCoeff() > 0.0) || !sigma_rad_s.allFinite()) {
+        inv_sigma_(sigma_radps.cwiseInverse()) {
+    if (!(sigma_radps.minCoeff() > 0.0) || !sigma_radps.allFinite()) {
       throw std::invalid_argument("StaticGyroResidual: sigma must be positive and finite");
     }
   }
@@ -118,25 +118,6 @@ class GyroMoveResidual {
  private:
   const GyroMove* move_;
 };
-
-/// Right Jacobian of SO(3): Exp(phi + d) ~ Exp(phi) Exp(Jr(phi) d).
-inline Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& phi) {
-  const double t2 = phi.squaredNorm();
-  const Eigen::Matrix3d W = Skew(phi);
-  if (t2 < 1e-8) return Eigen::Matrix3d::Identity() - 0.5 * W + W * W / 6.0;
-  const double t = std::sqrt(t2);
-  return Eigen::Matrix3d::Identity() - (1.0 - std::cos(t)) / t2 * W + (t - std::sin(t)) / (t2 * t) * W * W;
-}
-
-/// Inverse of the right Jacobian: Log(R Exp(d)) ~ Log(R) + JrInv(Log R) d.
-inline Eigen::Matrix3d RightJacobianInverseSO3(const Eigen::Vector3d& phi) {
-  const double t2 = phi.squaredNorm();
-  const Eigen::Matrix3d W = Skew(phi);
-  if (t2 < 1e-8) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 12.0;
-  const double t = std::sqrt(t2);
-  return Eigen::Matrix3d::Identity() + 0.5 * W +
-         (1.0 / t2 - (1.0 + std::cos(t)) / (2.0 * t * std::sin(t))) * W * W;
-}
 
 class GyroMoveCost : public ceres::SizedCostFunction<3, kTriadParameters, kGSensitivityParameters> {
  public:
@@ -202,4 +183,4 @@ class GyroMoveCost : public ceres::SizedCostFunction<3, kTriadParameters, kGSens
   const GyroMove* move_;
 };
 
-}  // namespace navtwin
+}  // namespace navtwin::calibration

@@ -47,7 +47,7 @@
 #include <ceres/cost_function.h>
 #include <Eigen/Core>
 
-namespace navtwin {
+namespace navtwin::inflight {
 
 class DistanceHeadingResidual {
  public:
@@ -217,4 +217,4 @@ class VectorPrior2 {
   Eigen::Vector2d inv_sigma_;
 };
 
-}  // namespace navtwin
+}  // namespace navtwin::inflight

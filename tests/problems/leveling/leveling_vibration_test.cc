@@ -3,7 +3,7 @@
 // analytic Jacobian block against autodiff of that reference and against central
 // differences, at zero, at a tiny perturbation and at a random point (fixed seed), for one
 // sample and for a window of samples; the window form is the samples stacked.
-#include "factors/leveling_vibration.h"
+#include "problems/leveling/leveling_vibration.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,11 +19,11 @@
 #include <gtest/gtest.h>
 
 #include "core/leveling_model.h"
+#include "core/units.h"
 
-namespace navtwin {
+namespace navtwin::leveling {
 namespace {
 
-constexpr double kG = 9.80665;
 constexpr double kSigma = 0.49;  // 50 mg
 
 // The residuals of the header comment written with the shared model and plain cos/sin of
@@ -39,7 +39,7 @@ struct Reference {
     using std::cos;
     using std::sin;
     for (size_t k = 0; k < t_s.size(); ++k) {
-      Eigen::Matrix<T, 3, 1> e = leveling::SpecificForceAtRest(p[0][0], p[0][1], T(kG)) - f_meas[k].cast<T>();
+      Eigen::Matrix<T, 3, 1> e = leveling::SpecificForceAtRest(p[0][0], p[0][1], T(kStandardGravity_mps2)) - f_meas[k].cast<T>();
       for (int h = 1; h <= num_harmonics; ++h) {
         const T w = T(2.0 * M_PI * h * t_s[k]) * p[1][0];
         for (int a = 0; a < 3; ++a) e[a] += p[1 + h][2 * a] * cos(w) + p[1 + h][2 * a + 1] * sin(w);
@@ -142,10 +142,10 @@ std::vector<Point> Points(int num_harmonics, bool with_bias) {
 std::unique_ptr<ceres::CostFunction> Create(const Point& p, int num_harmonics, bool with_bias) {
   if (p.t_s.size() == 1) {
     return std::unique_ptr<ceres::CostFunction>(
-        LevelingVibration::Create(p.t_s[0], p.f_meas[0], kG, kSigma, num_harmonics, with_bias));
+        LevelingVibration::Create(p.t_s[0], p.f_meas[0], kStandardGravity_mps2, kSigma, num_harmonics, with_bias));
   }
   return std::unique_ptr<ceres::CostFunction>(
-      LevelingVibration::Create(p.t_s, p.f_meas, kG, kSigma, num_harmonics, with_bias));
+      LevelingVibration::Create(p.t_s, p.f_meas, kStandardGravity_mps2, kSigma, num_harmonics, with_bias));
 }
 
 struct Layout {
@@ -193,13 +193,13 @@ INSTANTIATE_TEST_SUITE_P(Layouts, LevelingVibrationLayouts,
                          });
 
 TEST(LevelingVibrationTest, LayoutAndBlockIndices) {
-  const std::unique_ptr<ceres::CostFunction> f(LevelingVibration::Create(0.01, Eigen::Vector3d::Zero(), kG, 1.0, 2, true));
+  const std::unique_ptr<ceres::CostFunction> f(LevelingVibration::Create(0.01, Eigen::Vector3d::Zero(), kStandardGravity_mps2, 1.0, 2, true));
   EXPECT_EQ(f->num_residuals(), 3);
   EXPECT_EQ(f->parameter_block_sizes(), (std::vector<int32_t>{2, 1, 6, 6, 3}));
   EXPECT_EQ(LevelingVibration::HarmonicBlock(1), 2);
   EXPECT_EQ(LevelingVibration::BiasBlock(2), 4);
   EXPECT_EQ(LevelingVibration::BiasBlock(0), 1);
-  const std::unique_ptr<ceres::CostFunction> plain(LevelingVibration::Create(0.0, Eigen::Vector3d::Zero(), kG, 1.0, 0, false));
+  const std::unique_ptr<ceres::CostFunction> plain(LevelingVibration::Create(0.0, Eigen::Vector3d::Zero(), kStandardGravity_mps2, 1.0, 0, false));
   EXPECT_EQ(plain->parameter_block_sizes(), (std::vector<int32_t>{2}));
 }
 
@@ -208,7 +208,7 @@ TEST(LevelingVibrationTest, WindowIsTheSamplesStacked) {
   const std::unique_ptr<ceres::CostFunction> window = Create(p, 2, true);
   const Evaluation all = Evaluate(*window, p.blocks, true);
   for (size_t k = 0; k < p.t_s.size(); ++k) {
-    const std::unique_ptr<ceres::CostFunction> one(LevelingVibration::Create(p.t_s[k], p.f_meas[k], kG, kSigma, 2, true));
+    const std::unique_ptr<ceres::CostFunction> one(LevelingVibration::Create(p.t_s[k], p.f_meas[k], kStandardGravity_mps2, kSigma, 2, true));
     const Evaluation e = Evaluate(*one, p.blocks, true);
     // The same operations on the same values: equal to the last bit.
     EXPECT_EQ(all.residual.segment<3>(3 * k), e.residual);
@@ -221,7 +221,7 @@ TEST(LevelingVibrationTest, ValueOfAToneAtAKnownTime) {
   // 2 sin(pi / 2) = 2; the measurement equals the model except 1 m/s^2 less on x, so the
   // residual is (1, 0, 0) / sigma.
   const std::unique_ptr<ceres::CostFunction> f(
-      LevelingVibration::Create(0.01, Eigen::Vector3d(1.0, 0.0, -kG), kG, 0.5, 1, false));
+      LevelingVibration::Create(0.01, Eigen::Vector3d(1.0, 0.0, -kStandardGravity_mps2), kStandardGravity_mps2, 0.5, 1, false));
   const Evaluation e = Evaluate(*f, {{0.0, 0.0}, {25.0}, {0.0, 2.0, 0.0, 0.0, 0.0, 0.0}}, false);
   // sin(pi/2) and cos(pi/2) in floating point: 1e-15.
   EXPECT_NEAR(e.residual.x(), 2.0, 1e-12);
@@ -231,7 +231,7 @@ TEST(LevelingVibrationTest, ValueOfAToneAtAKnownTime) {
 
 TEST(LevelingVibrationTest, NullJacobianBlocksAreSkipped) {
   // Ceres passes nullptr for constant blocks: the others are still filled correctly.
-  const std::unique_ptr<ceres::CostFunction> f(LevelingVibration::Create(0.03, Eigen::Vector3d(0.5, 0.2, -9.7), kG, kSigma, 1, true));
+  const std::unique_ptr<ceres::CostFunction> f(LevelingVibration::Create(0.03, Eigen::Vector3d(0.5, 0.2, -9.7), kStandardGravity_mps2, kSigma, 1, true));
   const Blocks blocks{{0.1, -0.2}, {23.3}, {1.0, 2.0, 0.5, -0.5, 0.0, 0.1}, {0.01, 0.02, 0.03}};
   const Evaluation full = Evaluate(*f, blocks, true);
   std::vector<const double*> params;
@@ -246,17 +246,17 @@ TEST(LevelingVibrationTest, NullJacobianBlocksAreSkipped) {
 }
 
 TEST(LevelingVibrationTest, RejectsInvalidArguments) {
-  const Eigen::Vector3d f(0.0, 0.0, -kG);
+  const Eigen::Vector3d f(0.0, 0.0, -kStandardGravity_mps2);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   using V = std::vector<Eigen::Vector3d>;
-  EXPECT_THROW(LevelingVibration({0.0}, V{f}, kG, 0.0, 1, false), std::invalid_argument);
+  EXPECT_THROW(LevelingVibration({0.0}, V{f}, kStandardGravity_mps2, 0.0, 1, false), std::invalid_argument);
   EXPECT_THROW(LevelingVibration({0.0}, V{f}, -1.0, 1.0, 1, false), std::invalid_argument);
-  EXPECT_THROW(LevelingVibration({nan}, V{f}, kG, 1.0, 1, false), std::invalid_argument);
-  EXPECT_THROW(LevelingVibration({0.0}, V{Eigen::Vector3d(nan, 0.0, 0.0)}, kG, 1.0, 1, false), std::invalid_argument);
-  EXPECT_THROW(LevelingVibration({0.0}, V{f}, kG, 1.0, -1, false), std::invalid_argument);
-  EXPECT_THROW(LevelingVibration({}, V{}, kG, 1.0, 1, false), std::invalid_argument);
-  EXPECT_THROW(LevelingVibration({0.0, 0.1}, V{f}, kG, 1.0, 1, false), std::invalid_argument);
+  EXPECT_THROW(LevelingVibration({nan}, V{f}, kStandardGravity_mps2, 1.0, 1, false), std::invalid_argument);
+  EXPECT_THROW(LevelingVibration({0.0}, V{Eigen::Vector3d(nan, 0.0, 0.0)}, kStandardGravity_mps2, 1.0, 1, false), std::invalid_argument);
+  EXPECT_THROW(LevelingVibration({0.0}, V{f}, kStandardGravity_mps2, 1.0, -1, false), std::invalid_argument);
+  EXPECT_THROW(LevelingVibration({}, V{}, kStandardGravity_mps2, 1.0, 1, false), std::invalid_argument);
+  EXPECT_THROW(LevelingVibration({0.0, 0.1}, V{f}, kStandardGravity_mps2, 1.0, 1, false), std::invalid_argument);
 }
 
 }  // namespace
-}  // namespace navtwin
+}  // namespace navtwin::leveling

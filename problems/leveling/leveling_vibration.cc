@@ -1,4 +1,4 @@
-#include "factors/leveling_vibration.h"
+#include "problems/leveling/leveling_vibration.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "core/leveling_model.h"
 
-namespace navtwin {
+namespace navtwin::leveling {
 
 LevelingVibration::LevelingVibration(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& f_meas_b_mps2,
                                      double g_mps2, double sigma_mps2, int num_harmonics, bool with_bias)
@@ -86,4 +86,4 @@ bool LevelingVibration::Evaluate(double const* const* parameters, double* residu
   return true;
 }
 
-}  // namespace navtwin
+}  // namespace navtwin::leveling

@@ -34,7 +34,7 @@
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
 
-namespace navtwin {
+namespace navtwin::leveling {
 
 class LevelingVibration final : public ceres::CostFunction {
  public:
@@ -76,4 +76,4 @@ class LevelingVibration final : public ceres::CostFunction {
   bool with_bias_;
 };
 
-}  // namespace navtwin
+}  // namespace navtwin::leveling

@@ -1,4 +1,4 @@
-#include "core/sim/yaml_config.h"
+#include "core/config/yaml_config.h"
 
 #include <cmath>
 #include <fstream>
@@ -6,7 +6,7 @@
 
 #include "core/io/input_error.h"
 
-namespace navtwin::sim {
+namespace navtwin {
 
 std::string ConfigNode::KeyPath(const std::string& key) const {
   if (key.empty()) return path_;
@@ -87,6 +87,14 @@ double ConfigNode::Positive(const std::string& key, double fallback) const {
     Fail(key, m.str());
   }
   return v;
+}
+
+double ConfigNode::PositiveSi(const std::string& key, double unit_si, double fallback_si) const {
+  return Has(key) ? Positive(key, 0.0) * unit_si : fallback_si;
+}
+
+double ConfigNode::NonNegativeSi(const std::string& key, double unit_si, double fallback_si) const {
+  return Has(key) ? NonNegative(key, 0.0) * unit_si : fallback_si;
 }
 
 double ConfigNode::NonNegative(const std::string& key, double fallback) const {
@@ -203,4 +211,4 @@ ConfigNode LoadYamlFile(const std::string& path) {
   return ParseYaml(ss.str(), path);
 }
 
-}  // namespace navtwin::sim
+}  // namespace navtwin

@@ -2,7 +2,7 @@
 // off it), Jacobians of all three blocks against central differences and against the
 // closed form of the header at the zero-residual point, a tiny perturbation of it and a
 // random point (fixed seed), the finite value at A (m - h) = 0, and the constructor's checks.
-#include "factors/mag_ellipsoid.h"
+#include "problems/calibration/mag_ellipsoid.h"
 
 #include <cmath>
 #include <limits>
@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 
-namespace navtwin {
+namespace navtwin::calibration {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -157,4 +157,4 @@ TEST(MagEllipsoid, RejectsBadArguments) {
 }
 
 }  // namespace
-}  // namespace navtwin
+}  // namespace navtwin::calibration

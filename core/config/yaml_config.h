@@ -1,7 +1,8 @@
-// Reading the simulator's YAML configuration with errors that name the file, the line
-// and the key path (e.g. "scenario.yaml:line 12: field 'imu.gyro.arw_deg_sqrt_h': must be
+// Reading a YAML configuration (the simulator's scenarios, the problems' configurations,
+// calibration files) with errors that name the file, the line and the key path (e.g. "scenario.yaml:line 12: field 'imu.gyro.arw_deg_sqrt_h': must be
 // >= 0"). Unknown keys are errors, so a typo never silently falls back to a default.
-// Keys carry their units (bias_deg_h, arw_deg_sqrt_h, rate_hz, lever_arm_b_m).
+// Keys carry their units (bias_deg_h, arw_deg_sqrt_h, rate_hz, lever_arm_b_m); readers
+// convert them to SI with core/units.h as they read, so structs hold SI only.
 #pragma once
 
 #include <initializer_list>
@@ -11,7 +12,7 @@
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
-namespace navtwin::sim {
+namespace navtwin {
 
 /// A YAML mapping with the file it came from and its key path, for messages.
 class ConfigNode {
@@ -35,6 +36,11 @@ class ConfigNode {
   double Positive(const std::string& key, double fallback) const;
   /// A noise density or bias size where 0 means none: finite and >= 0.
   double NonNegative(const std::string& key, double fallback) const;
+  /// Positive / NonNegative of a key in a people unit (named in the key, e.g. bias_deg_h),
+  /// returned in SI: value * unit_si, e.g. unit_si = kDegPerHour_radps (core/units.h). An
+  /// absent key returns fallback_si unchanged (already SI).
+  double PositiveSi(const std::string& key, double unit_si, double fallback_si) const;
+  double NonNegativeSi(const std::string& key, double unit_si, double fallback_si) const;
   double RequiredDouble(const std::string& key) const;
   int Int(const std::string& key, int fallback, int lo, int hi) const;
   bool Bool(const std::string& key, bool fallback) const;
@@ -71,4 +77,4 @@ void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3
 ConfigNode ParseYaml(const std::string& text, const std::string& file);
 ConfigNode LoadYamlFile(const std::string& path);
 
-}  // namespace navtwin::sim
+}  // namespace navtwin
