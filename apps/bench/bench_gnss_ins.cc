@@ -29,11 +29,11 @@
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/output.h"
 #include "problems/ins/pure_ins.h"
+#include "core/units.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
-constexpr double kDegToRadB = 3.14159265358979323846 / 180.0;
 
 double PeakRss_MB() {
   rusage usage{};
@@ -55,18 +55,17 @@ class NavGradeHour {
   /// The configuration a user of this IMU would write (the preset's specification values).
   GnssInsConfig Config(double minutes) const {
     GnssInsConfig c;
-    const double deg_h = kDegToRadB / 3600.0;
-    c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.002 * kDegToRadB / 60.0;
-    c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.01 / 60.0;
-    c.imu_noise.gyro_bias_std_radps = 0.005 * deg_h;
-    c.imu_noise.accel_bias_std_mps2 = 25e-6 * 9.80665;
-    c.imu_noise.correlation_time_s = 3600.0;
+    c.imu_noise.gyro_arw_rad_per_sqrt_s = 0.002 * kDegPerSqrtHour_radpsqrts;
+    c.imu_noise.accel_vrw_mps_per_sqrt_s = 0.01 * kMpsPerSqrtHour_mpspsqrts;
+    c.imu_noise.gyro_bias_std_radps = 0.005 * kDegPerHour_radps;
+    c.imu_noise.accel_bias_std_mps2 = 25.0 * kMicroG_mps2;
+    c.imu_noise.correlation_time_s = kHour_s;
     c.installation.antenna_lever_arm_b_m = Eigen::Vector3d(0.5, 0.0, -1.5);
     c.init.source = InitConfig::Source::kGiven;
     c.init.state = InsState{initial_, ImuErrors{}};
     c.init.std.pos_ned_m.setConstant(0.05);
     c.init.std.vel_ned_mps.setConstant(0.01);
-    c.init.std.att_rad.setConstant(0.01 * kDegToRadB);
+    c.init.std.att_rad.setConstant(0.01 * kDegToRad);
     c.end_time_s = initial_.t_s + minutes * 60.0;
     return c;
   }

@@ -13,6 +13,7 @@
 #include "core/sim/inertial_errors.h"
 #include "core/sim/random.h"
 #include "problems/calibration/multiposition.h"
+#include "core/units.h"
 
 namespace navtwin::calibration {
 namespace {
@@ -32,15 +33,15 @@ const MultiPositionData& Data() {
       }
     }
     sim::InertialErrorConfig c;
-    c.gyro.bias.sigma = kDegToRad / 3600.0;
-    c.gyro.white_noise = 0.05 * kDegToRad / 60.0;
+    c.gyro.bias.sigma = kDegPerHour_radps;
+    c.gyro.white_noise = 0.05 * kDegPerSqrtHour_radpsqrts;
     c.gyro.scale_factor.sigma = 300e-6;
     c.gyro.misalignment.sigma = 0.5e-3;
-    c.accel.bias.sigma = 1e-3 * 9.80665;
+    c.accel.bias.sigma = kMilliG_mps2;
     c.accel.white_noise = 0.05 / 60.0;
     c.accel.scale_factor.sigma = 300e-6;
     c.accel.misalignment.sigma = 0.5e-3;
-    c.g_sensitivity.sigma = kDegToRad / 3600.0 / 9.80665;
+    c.g_sensitivity.sigma = kDegPerHour_radps / kStandardGravity_mps2;
     sim::InertialErrorModel model(c, sim::Rng(11).Stream("imu"), false);
     const sim::MultiPositionRig rig(d.schedule);
     sim::SynthesizeImu(rig, wgs84::Geodetic{d.latitude_rad, 0.0, d.height_m}, 100.0, rig.duration_s() + 1.0,
@@ -61,7 +62,7 @@ void BM_BatchMultiPosition(benchmark::State& state) {
   for (auto _ : state) r = CalibrateMultiPosition(data);
   state.counters["samples"] = static_cast<double>(data.imu.size());
   state.counters["positions"] = r.positions;
-  state.counters["accel_bias_x_sigma_mg"] = (*r.calibration.accel_sigma)(9) / 9.80665e-3;
+  state.counters["accel_bias_x_sigma_mg"] = (*r.calibration.accel_sigma)(9) / kMilliG_mps2;
 }
 BENCHMARK(BM_BatchMultiPosition)->Unit(benchmark::kMillisecond)->UseRealTime();
 

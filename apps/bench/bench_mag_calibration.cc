@@ -11,13 +11,14 @@
 
 #include "core/sim/random.h"
 #include "problems/calibration/mag_calibration.h"
+#include "core/units.h"
 
 namespace navtwin::calibration {
 namespace {
 
 std::vector<MagSample> Simulate(int n) {
   sim::Rng rng(8);
-  const double inclination = 57.0 * M_PI / 180.0;
+  const double inclination = 57.0 * kDegToRad;
   const Eigen::Vector3d field_ned = 50.0 * Eigen::Vector3d(std::cos(inclination), 0.0, std::sin(inclination));
   const Eigen::Vector3d h(22.0, -15.0, 28.0);
   Eigen::Matrix3d M;

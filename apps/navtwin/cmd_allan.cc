@@ -18,14 +18,13 @@
 #include "core/io/json_writer.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
+#include "core/units.h"
 
 DEFINE_string(axis, "all", "allan: axis to analyse: gx, gy, gz (gyros), ax, ay, az (accelerometers) or all");
 
 namespace navtwin::app {
 namespace {
 
-constexpr double kMicroG_mps2 = 9.80665e-6;  // 1 ug with standard gravity
-constexpr double kSqrtHour_sqrts = 60.0;
 constexpr double kIrregularFraction = 0.1;   // an interval this far from tau0 is reported
 
 /// One IMU axis. Its Allan deviation and bias instability are shown in deg/h (gyros) or
@@ -40,7 +39,7 @@ struct Axis {
 constexpr Axis kAxes[] = {{"gx", 0, true, "deg_h"}, {"gy", 1, true, "deg_h"}, {"gz", 2, true, "deg_h"},
                           {"ax", 0, false, "ug"},   {"ay", 1, false, "ug"},   {"az", 2, false, "ug"}};
 
-double RateScale(const Axis& a) { return a.gyro ? kRadToDeg * 3600.0 : 1.0 / kMicroG_mps2; }
+double RateScale(const Axis& a) { return a.gyro ? 1.0 / kDegPerHour_radps : 1.0 / kMicroG_mps2; }
 /// N: rad/sqrt(s) -> deg/sqrt(h); m/s/sqrt(s) -> m/s/sqrt(h).
 double WhiteScale(const Axis& a) { return (a.gyro ? kRadToDeg : 1.0) * kSqrtHour_sqrts; }
 /// K: rad/s/sqrt(s) -> deg/h/sqrt(h); m/s^2/sqrt(s) -> ug/sqrt(h).

@@ -140,8 +140,14 @@ BiasModel MakeBiasModel(double steady_std, double tau_s, const Eigen::Vector3d& 
 
 class BatchSmoother : public ins::BatchAccess {
  public:
-  BatchSmoother(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, std::ostream* progress)
-      : in_(inputs), cfg_(config), start_(start), progress_(progress), sources_(MakeSources(inputs, config)) {}
+  BatchSmoother(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, const FilterStart* initial,
+                std::ostream* progress)
+      : in_(inputs),
+        cfg_(config),
+        start_(start),
+        initial_(initial),
+        progress_(progress),
+        sources_(MakeSources(inputs, config)) {}
 
   Solution Run();
 
@@ -179,6 +185,7 @@ class BatchSmoother : public ins::BatchAccess {
   const Inputs& in_;
   const GnssInsConfig& cfg_;
   const Solution& start_;
+  const FilterStart* initial_;  ///< the filter's initial state (null: computed for the prior)
   std::ostream* progress_;
 
   ins::AidingSources sources_;
@@ -281,7 +288,7 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   ImuErrors errors = knots.front().state.imu;
   std::size_t kn = 1, si = 0;
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();
-  const ins::ZuptConfig* still_rule = ins::StillnessRule(sources_);
+  const ins::StillnessConfig* still_rule = ins::StillnessRule(sources_);
   std::optional<ins::StillnessDetector> detector;
   if (still_rule != nullptr) detector.emplace(*still_rule);
   ImuErrors scale;  // the scale factors of the current interval (biases zero)
@@ -390,12 +397,16 @@ void BatchSmoother::AddPriors() {
   // Centred on the filter's initial state when it starts at the first state's time (the
   // prior the filter used), else on the first knot.
   InsState centre = start_.epochs.front().state;
-  try {
-    const FilterStart fs = InitialFilterState(in_, cfg_);
-    if (std::abs(fs.state.nav.t_s - states_.front().t_s) <= kTimeEps_s) centre = fs.state;
-  } catch (const std::exception&) {
-    // No initial state from the configuration: the first knot.
+  std::optional<FilterStart> computed;
+  if (initial_ == nullptr) {
+    try {
+      computed = InitialFilterState(in_, cfg_);
+    } catch (const std::exception&) {
+      // No initial state from the configuration: the first knot.
+    }
   }
+  const FilterStart* fs = initial_ != nullptr ? initial_ : (computed ? &*computed : nullptr);
+  if (fs != nullptr && std::abs(fs->state.nav.t_s - states_.front().t_s) <= kTimeEps_s) centre = fs->state;
   const Eigen::VectorXd std = InitialStdVector(cfg_, err::kSize15);
   BatchState& s = states_.front();
   const NavState& c = centre.nav;
@@ -620,7 +631,12 @@ std::vector<double> BatchStateTimes(const Inputs& inputs, const GnssInsConfig& c
 }
 
 Solution RunBatch(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, std::ostream* progress) {
-  BatchSmoother smoother(inputs, config, start, progress);
+  return RunBatch(inputs, config, start, nullptr, progress);
+}
+
+Solution RunBatch(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, const FilterStart* initial,
+                  std::ostream* progress) {
+  BatchSmoother smoother(inputs, config, start, initial, progress);
   return smoother.Run();
 }
 

@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "problems/gnss_ins/config.h"
+#include "problems/gnss_ins/initial_state.h"
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/solution.h"
 
@@ -61,6 +62,12 @@ constexpr int kMaxReintegrationRounds = 3;
 /// record, non-positive ARW or VRW, or kVector magnetometer mode without a field.
 Solution RunBatch(const Inputs& inputs, const GnssInsConfig& config, const Solution& start,
                   std::ostream* progress);
+
+/// The same with the filter's initial state given (InitialFilterState, run once before the
+/// filter): the prior on the first state is centred on it when it starts at the same time
+/// (null: computed here, as above).
+Solution RunBatch(const Inputs& inputs, const GnssInsConfig& config, const Solution& start,
+                  const FilterStart* initial, std::ostream* progress);
 
 /// The state epochs RunBatch uses from t0_s (the start's first knot) to t_end_s (the end
 /// of the IMU record): t0, the GNSS epochs in (t0, t_end] (thinned to

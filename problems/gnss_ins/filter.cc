@@ -59,7 +59,7 @@ class NavigationFilter : public ins::FilterAccess {
     P_ = kf_->P();
     phi_acc_ = Eigen::MatrixXd::Identity(n_, n_);
     epoch_dx_ = Eigen::VectorXd::Zero(n_);
-    if (const ins::ZuptConfig* rule = ins::StillnessRule(sources_)) detector_.emplace(*rule);
+    if (const ins::StillnessConfig* rule = ins::StillnessRule(sources_)) detector_.emplace(*rule);
   }
 
   FilterResult Run();

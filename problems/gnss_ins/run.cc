@@ -51,9 +51,11 @@ void RunEstimators(const RunOptions& options, const GnssInsConfig& config, const
   const bool run_rts = options.methods != RunMethods::kFilter;
   const bool run_batch = options.methods == RunMethods::kAll;
   if (options.progress) *options.progress << options.command << ": filter" << (run_rts ? " + RTS smoother" : "") << "\n";
+  // The alignment runs once, before the filter; the batch's prior is the same start.
+  const FilterStart start = InitialFilterState(inputs, config, options.progress);
   const Scorer filter_scorer = open_scorer();
   FilterResult fr = RunFilter(
-      inputs, config, run_rts,
+      inputs, config, start, run_rts,
       [&](const NavEpoch& e) {
         if (filter_scorer) filter_scorer->Add(e.state.nav);
         if (!run_rts) writer->Write(e);
@@ -70,7 +72,7 @@ void RunEstimators(const RunOptions& options, const GnssInsConfig& config, const
   if (options.progress) {
     *options.progress << options.command << ": batch smoother (Ceres) started from the RTS solution\n";
   }
-  Solution batch = RunBatch(inputs, config, run->methods.back().solution, options.progress);
+  Solution batch = RunBatch(inputs, config, run->methods.back().solution, &start, options.progress);
   run->methods.push_back(
       DensifyAndScore("batch", std::move(batch), inputs, config.output_rate_hz, open_scorer(), writer));
   run->output_method = "batch";

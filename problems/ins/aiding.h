@@ -24,7 +24,7 @@ class CostFunction;
 
 namespace navtwin::ins {
 
-struct ZuptConfig;
+struct StillnessConfig;
 
 /// A state block a measurement depends on, in the order of the cost function's parameter
 /// blocks: position {lat_rad, lon_rad, h_m} (PositionManifold), v_n_mps (3),
@@ -130,7 +130,7 @@ class AidingSource {
   /// Whether the batch places a state at each sample time (at most one source does).
   virtual bool anchors_batch_states() const { return false; }
   /// The stillness rule this source decides with (null: none).
-  virtual const ZuptConfig* stillness_rule() const { return nullptr; }
+  virtual const StillnessConfig* stillness_rule() const { return nullptr; }
   virtual std::vector<AuxState> aux_states() const { return {}; }
   /// The filter starts; samples before first_time_s are not used.
   virtual void BeginFilter(double first_time_s) { (void)first_time_s; }
@@ -148,7 +148,7 @@ class AidingSource {
 using AidingSources = std::vector<std::unique_ptr<AidingSource>>;
 
 /// The first stillness rule among the sources (null: none).
-inline const ZuptConfig* StillnessRule(const AidingSources& sources) {
+inline const StillnessConfig* StillnessRule(const AidingSources& sources) {
   for (const auto& s : sources) {
     if (s->stillness_rule() != nullptr) return s->stillness_rule();
   }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/earth.h"
+#include "core/leveling_model.h"
 #include "core/rotation.h"
 
 namespace navtwin::ins {
@@ -58,8 +59,9 @@ Eigen::Quaterniond StaticCoarseAlignment(const std::vector<ImuSample>& samples, 
         std::to_string(omega.norm()) + " rad/s)");
   }
   // At rest f_b = -R_b_n g_n = g (sin p, -cos p sin r, -cos p cos r).
-  const double roll = std::atan2(-f.y(), -f.z());
-  const double pitch = std::atan2(f.x(), std::hypot(f.y(), f.z()));
+  const leveling::RollPitch level = leveling::LevelFromSpecificForce(f);
+  const double roll = level.roll_rad;
+  const double pitch = level.pitch_rad;
   double yaw = 0.0;
   if (m_b_uT) {
     yaw = YawOfLevelledVector(*m_b_uT, roll, pitch, "magnetic field") + declination_rad;

@@ -15,14 +15,19 @@ namespace navtwin::ins {
 /// none (NaN).
 Eigen::Vector3d MeasurementSigma(const Eigen::Vector3d& file_sigma, double floor, double fallback);
 
-/// Zero-velocity updates and the stillness rule's thresholds.
-struct ZuptConfig {
-  bool enabled = false;
-  double std_mps = 0.02;
+/// The stillness rule's thresholds.
+struct StillnessConfig {
   double window_s = 0.5;                 ///< detection window
   double gyro_threshold_radps = 0.01;    ///< max |omega| over the window
   double accel_std_threshold_mps2 = 0.05;///< max std of |f| over the window
-  double interval_s = 0.1;               ///< at most one update per this interval
+};
+
+/// Zero-velocity updates where the stillness rule holds (its thresholds are the ZUPT's
+/// configuration keys).
+struct ZuptConfig : StillnessConfig {
+  bool enabled = false;
+  double std_mps = 0.02;
+  double interval_s = 0.1;  ///< at most one update per this interval
 };
 
 /// Stillness detection: the vehicle is still when, over the last window_s of IMU samples
@@ -31,7 +36,7 @@ struct ZuptConfig {
 /// accel_std_threshold_mps2. Samples are added in time order.
 class StillnessDetector {
  public:
-  explicit StillnessDetector(const ZuptConfig& config) : config_(config) {}
+  explicit StillnessDetector(const StillnessConfig& config) : config_(config) {}
   void Add(const ImuSample& s);
   /// Whether the samples cover the whole window and satisfy both thresholds.
   bool Still() const;
@@ -42,7 +47,7 @@ class StillnessDetector {
     double f_mps2;    ///< |f| - 9.8 (offset so that the sums of squares do not cancel)
     bool moving;      ///< |omega| above the threshold
   };
-  ZuptConfig config_;
+  StillnessConfig config_;
   std::deque<Entry> window_;
   int moving_ = 0;
   double sum_ = 0.0, sum_sq_ = 0.0;

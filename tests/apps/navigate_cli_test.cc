@@ -218,7 +218,7 @@ TEST(NavigateCli, RunsAnObginsConfigurationWithItsOdometerColumn) {
                        "isuseoutage: false\noutagetime: 0\noutagelen: 60\noutageperiod: 180\ngnssthreshold: 20.0\n";
   const RunResult run = Navtwin("navigate --obgins_config " + ob + " --format=json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_NE(run.err.find("windows (line 5)"), std::string::npos) << run.err;  // listed as not used
+  EXPECT_NE(run.err.find("windows (line 4)"), std::string::npos) << run.err;  // listed as not used
   EXPECT_TRUE(Exists(r.dir + "/ob_out/nav.nav"));
   // The odometer column is used from the first fix on (19 s at 100 Hz, minus the start).
   const double odometer_used = JsonNumberAfter(run.out, "\"odometer\":", "used");

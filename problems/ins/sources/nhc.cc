@@ -19,7 +19,7 @@ bool Standing(bool imu_still, const Eigen::Vector3d& v_n_mps) {
 
 class NhcSource : public AidingSource {
  public:
-  NhcSource(const NhcConfig& config, const VehicleConfig& vehicle, const ZuptConfig& still_rule)
+  NhcSource(const NhcConfig& config, const VehicleConfig& vehicle, const StillnessConfig& still_rule)
       : config_(config),
         lever_b_m_(vehicle.lever_arm_b_m),
         R_v_b_(DcmFromEuler<double>(vehicle.mounting_rpy_rad[0], vehicle.mounting_rpy_rad[1],
@@ -29,7 +29,7 @@ class NhcSource : public AidingSource {
   std::vector<std::string> keys() const override { return {kNhc}; }
   Timing timing() const override { return Timing::kEveryEpoch; }
   const std::vector<double>& times() const override { return none_; }
-  const ZuptConfig* stillness_rule() const override { return &still_rule_; }
+  const StillnessConfig* stillness_rule() const override { return &still_rule_; }
 
   void FilterEpoch(FilterAccess& filter) override {
     const double t_s = filter.time_s();
@@ -56,7 +56,7 @@ class NhcSource : public AidingSource {
   NhcConfig config_;
   Eigen::Vector3d lever_b_m_;
   Eigen::Matrix3d R_v_b_;
-  ZuptConfig still_rule_;
+  StillnessConfig still_rule_;
   std::vector<double> none_;
   double last_s_ = -INFINITY;
 };
@@ -64,7 +64,7 @@ class NhcSource : public AidingSource {
 }  // namespace
 
 std::unique_ptr<AidingSource> MakeNhcSource(const NhcConfig& config, const VehicleConfig& vehicle,
-                                            const ZuptConfig& still_rule) {
+                                            const StillnessConfig& still_rule) {
   return std::make_unique<NhcSource>(config, vehicle, still_rule);
 }
 

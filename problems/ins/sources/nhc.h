@@ -34,8 +34,8 @@ struct NhcConfig {
   double interval_s = 1.0;
 };
 
-/// Count key "nhc". still_rule: the stillness thresholds (the ZUPT's).
+/// Count key "nhc". still_rule: the stillness thresholds (the ZUPT configuration's).
 std::unique_ptr<AidingSource> MakeNhcSource(const NhcConfig& config, const VehicleConfig& vehicle,
-                                            const ZuptConfig& still_rule);
+                                            const StillnessConfig& still_rule);
 
 }  // namespace navtwin::ins

@@ -16,7 +16,7 @@ class ZuptSource : public AidingSource {
   std::vector<std::string> keys() const override { return {kZupt}; }
   Timing timing() const override { return Timing::kEveryEpoch; }
   const std::vector<double>& times() const override { return none_; }
-  const ZuptConfig* stillness_rule() const override { return config_.enabled ? &config_ : nullptr; }
+  const StillnessConfig* stillness_rule() const override { return config_.enabled ? &config_ : nullptr; }
 
   void FilterEpoch(FilterAccess& filter) override {
     const double t_s = filter.time_s();

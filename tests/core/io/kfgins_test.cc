@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/open.h"
 #include "core/rotation.h"
 #include "tests/core/io/io_test_util.h"
 
@@ -86,8 +87,9 @@ TEST(KfginsTest, ObginsEighthColumnIsTheOdometer) {
   EXPECT_EQ(odo[1].speed_mps, 3.25);
   const std::string seven = WriteTempFile("imu7.txt", "100.00 1e-4 0 0 0 0 -0.098\n100.01 1e-4 0 0 0 0 -0.098\n");
   ExpectInputError([&] { ReadOdometer(seven); }, {seven, "line 1", "odo", "no odometer column"});
-  const std::string nan = WriteTempFile("imu_nan.txt", "100.00 1e-4 0 0 0 0 -0.098 nan\n");
-  ExpectInputError([&] { ReadOdometer(nan); }, {nan, "line 1", "odo", "not a finite number"});
+  const std::string nan =
+      WriteTempFile("imu_nan.txt", "100.00 1e-4 0 0 0 0 -0.098 3.5\n100.01 1e-4 0 0 0 0 -0.098 nan\n");
+  ExpectInputError([&] { ReadOdometer(nan); }, {nan, "line 2", "odo", "not a finite number"});
 }
 
 TEST(KfginsTest, GnssRoundTripWithAndWithoutVelocity) {
