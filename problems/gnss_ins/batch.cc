@@ -608,6 +608,7 @@ Solution BatchSmoother::Run() {
   }
   if (cfg_.batch.covariance) Covariance(&solution, &report);
   solution.counts = counts_;
+  for (const ins::AuxState& a : aux_states_) solution.aux_names.push_back(a.name);
   solution.solver_report = report.str();
   if (!solution.solver_report.empty() && solution.solver_report.back() == '\n') solution.solver_report.pop_back();
   solution.run_time_s = Seconds(wall_start);

@@ -93,6 +93,7 @@ class NavigationFilter : public ins::FilterAccess {
       for (const ins::AuxState& a : source->aux_states()) {
         aux_values.push_back(a.initial);
         aux_std0_.push_back(a.initial_std);
+        aux_names_.push_back(a.name);
       }
     }
     aux_ = Eigen::Map<const Eigen::VectorXd>(aux_values.data(), static_cast<Eigen::Index>(aux_values.size()));
@@ -263,6 +264,7 @@ class NavigationFilter : public ins::FilterAccess {
   Eigen::VectorXd aux_;       ///< the sources' auxiliary states (nominal)
   Eigen::VectorXd aux_psd_;
   std::vector<double> aux_std0_;
+  std::vector<std::string> aux_names_;
   std::vector<int> aux_begin_;        ///< per source: its first auxiliary state
   std::vector<std::size_t> next_;     ///< per source: its next sample
   std::size_t current_ = 0;           ///< the source being processed
@@ -466,6 +468,7 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
   result.filter.method = "filter";
   result.filter.epochs = std::move(epochs_);
   result.filter.counts = counts_;
+  result.filter.aux_names = aux_names_;
   result.filter.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (run_rts_) {
     const RtsResult smoothed = RunRts(knots_);
@@ -474,6 +477,7 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
     Solution rts;
     rts.method = "rts";
     rts.counts = counts_;
+    rts.aux_names = aux_names_;
     rts.epochs.reserve(smoothed.dx.size());
     for (std::size_t i = 0; i < smoothed.dx.size(); ++i) {
       const NavEpoch& knot = result.filter.epochs[i];

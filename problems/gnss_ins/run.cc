@@ -178,6 +178,38 @@ void AppendErrorRow(std::string* s, const MethodRun& m, bool outages) {
   Append(s, " %10.2f\n", m.solution.run_time_s);
 }
 
+/// The auxiliary states (the aiding sources' parameters) at the end of a solution, with
+/// their std (NaN when not computed), dimensionless SI values.
+void WriteAuxStates(JsonWriter& w, const Solution& solution) {
+  if (solution.aux_names.empty() || solution.epochs.empty()) return;
+  const NavEpoch& last = solution.epochs.back();
+  w.Key("aux").BeginObject();
+  for (std::size_t i = 0; i < solution.aux_names.size(); ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(i);
+    const double value = k < last.aux.size() ? last.aux[k] : std::nan("");
+    const double std = k < last.aux_std.size() ? last.aux_std[k] : std::nan("");
+    w.Key(solution.aux_names[i]).BeginObject().Field("value", value).Field("std", std).EndObject();
+  }
+  w.EndObject();
+}
+
+/// One line per auxiliary state: each method's value at the end +- its std.
+void AppendAuxStates(std::string* s, const GnssInsRun& run) {
+  if (run.methods.empty()) return;
+  const std::vector<std::string>& names = run.methods.front().solution.aux_names;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(i);
+    Append(s, "%s at the end:", names[i].c_str());
+    for (const MethodRun& m : run.methods) {
+      if (m.solution.epochs.empty() || m.solution.epochs.back().aux.size() <= k) continue;
+      const NavEpoch& last = m.solution.epochs.back();
+      const double std = last.aux_std.size() > k ? last.aux_std[k] : std::nan("");
+      Append(s, " %s %.6g +- %.2g", m.name.c_str(), last.aux[k], std);
+    }
+    Append(s, "\n");
+  }
+}
+
 }  // namespace
 
 InputSummary SummarizeInputs(const Inputs& inputs) {
@@ -250,6 +282,7 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
       w.Key(key).BeginObject().Field("used", count.used).Field("rejected", count.rejected).EndObject();
     }
     w.EndObject();
+    WriteAuxStates(w, m.solution);
     if (!m.solution.solver_report.empty()) w.Field("solver_report", m.solution.solver_report);
     if (m.errors) {
       w.Key("errors");
@@ -289,6 +322,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   if (outages) Append(&s, " %10s %10s", "drift H[m]", "drift V[m]");
   Append(&s, " %10s\n", "run [s]");
   for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
+  AppendAuxStates(&s, run);
   return s;
 }
 

@@ -23,6 +23,9 @@ struct Solution {
   std::vector<NavEpoch> epochs;
   /// Keys: "gnss_position", "gnss_velocity", "mag", "baro", "zupt".
   std::map<std::string, MeasurementCount> counts;
+  /// Names of the epochs' auxiliary states (NavEpoch::aux; the aiding sources' parameters,
+  /// e.g. "odometer_scale"), in order.
+  std::vector<std::string> aux_names;
   double run_time_s = 0.0;
   std::string solver_report;  ///< batch: Ceres' brief report; filter: empty
 };

@@ -223,6 +223,10 @@ TEST(NavigateCli, RunsAnObginsConfigurationWithItsOdometerColumn) {
   // The odometer column is used from the first fix on (19 s at 100 Hz, minus the start).
   const double odometer_used = JsonNumberAfter(run.out, "\"odometer\":", "used");
   EXPECT_GT(odometer_used, 1800.0) << run.out;
+  // Standing still, the odometer's scale factor is not observable (d r / d s = v_x / sigma
+  // = 0): it keeps its prior, OB_GINS' srw of 100 ppm, in the summary.
+  EXPECT_NEAR(JsonNumberAfter(run.out, "\"odometer_scale\":", "std"), 100e-6, 1e-9) << run.out;
+  EXPECT_NEAR(JsonNumberAfter(run.out, "\"odometer_scale\":", "value"), 0.0, 1e-12) << run.out;
   // A 7-column IMU file has no odometer column: named with file, line and field.
   const RunResult no_column = Navtwin("navigate --obgins_config " + ob + " --imu " + r.imu + " --out " + r.dir + "/o7");
   EXPECT_EQ(no_column.exit_code, 1);
