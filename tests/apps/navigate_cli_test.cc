@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/apps/cli_util.h"
+#include "tests/problems/gnss_ins/static_record.h"
 
 #include "core/earth.h"
 
@@ -49,24 +50,7 @@ std::vector<std::string> Entries(const std::string& dir) {
 // ---------------------------------------------------------------------------------------
 // A tiny record: 20 s of a level, north-facing, static IMU at 100 Hz (gravity and Earth
 // rate, no errors) and 1 Hz GNSS at its position.
-constexpr double kLatDeg = 30.0, kLonDeg = 114.0, kH = 20.0;
-constexpr int kImuSamples = 2000;
-
-std::string ImuLine(int k) {
-  const double lat = kLatDeg * M_PI / 180.0, dt = 0.01;
-  const double omega = 7.292115e-5;  // Earth rate, rad/s
-  const double g = wgs84::NormalGravity(lat, kH);
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "%.2f %.12e 0 %.12e 0 0 %.12e\n", k * dt, omega * std::cos(lat) * dt,
-                -omega * std::sin(lat) * dt, -g * dt);
-  return buf;
-}
-
-std::string GnssLine(double t, double lat_deg = kLatDeg) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "%.1f %.9f %.9f %.3f 1.0 1.0 2.0\n", t, lat_deg, kLonDeg, kH);
-  return buf;
-}
+using namespace static_record;  // kLatDeg, kImuSamples, ImuLine, GnssLine, ConfigYaml
 
 struct Record {
   std::string dir, imu, gnss, config;
@@ -96,19 +80,7 @@ Record WriteRecord(const std::string& tag, const std::string& config_extra = "",
   } else {
     for (const std::string& l : gnss_lines) gnss << l;
   }
-  std::ofstream(r.config) << "imu_noise:\n"
-                             "  gyro_arw_deg_sqrt_h: 0.2\n"
-                             "  accel_vrw_m_s_sqrt_h: 0.1\n"
-                             "  gyro_bias_std_deg_h: 10\n"
-                             "  accel_bias_std_ug: 1000\n"
-                             "init:\n"
-                             "  source: given\n"
-                             "  time_s: 0\n"
-                             "  position_deg_m: [30, 114, 20]\n"
-                             "  velocity_mps: [0, 0, 0]\n"
-                             "  attitude_deg: [0, 0, 0]\n"
-                             "  attitude_std_deg: [0.5, 0.5, 2]\n"
-                          << config_extra;
+  std::ofstream(r.config) << ConfigYaml() << config_extra;
   return r;
 }
 

@@ -16,11 +16,11 @@
 
 #include "core/earth.h"
 #include "core/io/input_error.h"
+#include "tests/problems/gnss_ins/static_record.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
-constexpr double kLatDeg = 30.0, kLonDeg = 114.0, kH_m = 20.0;
 
 std::string MakeTempDir(const std::string& tag) {
   std::string dir = ::testing::TempDir() + "navtwin_run_" + tag + "_XXXXXX";
@@ -53,33 +53,13 @@ Record WriteRecord(const std::string& tag, bool zero_sigma = false) {
   r.imu = r.dir + "/imu.txt";
   r.gnss = r.dir + "/gnss.txt";
   r.config = r.dir + "/navtwin.yaml";
-  const double lat_rad = kLatDeg * M_PI / 180.0, dt_s = 0.01, omega_radps = 7.292115e-5;
-  const double g_mps2 = wgs84::NormalGravity(lat_rad, kH_m);
   std::ofstream imu(r.imu);
-  char line[200];
-  for (int k = 1; k <= 2000; ++k) {
-    std::snprintf(line, sizeof line, "%.2f %.12e 0 %.12e 0 0 %.12e\n", k * dt_s, omega_radps * std::cos(lat_rad) * dt_s,
-                  -omega_radps * std::sin(lat_rad) * dt_s, -g_mps2 * dt_s);
-    imu << line;
-  }
+  for (int k = 1; k <= static_record::kImuSamples; ++k) imu << static_record::ImuLine(k);
   std::ofstream gnss(r.gnss);
   for (int t = 0; t <= 20; ++t) {
-    std::snprintf(line, sizeof line, "%d.0 %.9f %.9f %.3f %s 1.0 2.0\n", t, kLatDeg, kLonDeg, kH_m,
-                  zero_sigma && t == 10 ? "0.0" : "1.0");
-    gnss << line;
+    gnss << static_record::GnssLine(t, static_record::kLatDeg, zero_sigma && t == 10 ? "0.0" : "1.0");
   }
-  std::ofstream(r.config) << "imu_noise:\n"
-                             "  gyro_arw_deg_sqrt_h: 0.2\n"
-                             "  accel_vrw_m_s_sqrt_h: 0.1\n"
-                             "  gyro_bias_std_deg_h: 10\n"
-                             "  accel_bias_std_ug: 1000\n"
-                             "init:\n"
-                             "  source: given\n"
-                             "  time_s: 0\n"
-                             "  position_deg_m: [30, 114, 20]\n"
-                             "  velocity_mps: [0, 0, 0]\n"
-                             "  attitude_deg: [0, 0, 0]\n"
-                             "  attitude_std_deg: [0.5, 0.5, 2]\n";
+  std::ofstream(r.config) << static_record::ConfigYaml();
   return r;
 }
 

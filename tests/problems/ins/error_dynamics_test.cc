@@ -384,28 +384,40 @@ Eigen::MatrixXd RandomSpd(int n, std::mt19937* rng) {
   return L * L.transpose() / n + Eigen::MatrixXd::Identity(n, n);
 }
 
+/// A climbing, turning state with every IMU error non-zero, and its noise model, for the
+/// covariance-propagation checks.
+InsState ClimbingTurnState() {
+  InsState x;
+  x.nav.lat_rad = 0.7;
+  x.nav.h_m = 1200.0;
+  x.nav.v_n_mps = Eigen::Vector3d(40.0, -25.0, 3.0);
+  x.nav.q_n_b = QuatFromEuler(0.2, -0.1, 2.5);
+  x.imu.bg_radps = Eigen::Vector3d(1e-4, -2e-4, 3e-4);
+  x.imu.ba_mps2 = Eigen::Vector3d(0.05, -0.02, 0.03);
+  x.imu.sg = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+  x.imu.sa = Eigen::Vector3d(-1e-3, 3e-3, 2e-3);
+  return x;
+}
+
+ImuNoise PropagationNoise() {
+  ImuNoise noise;
+  noise.gyro_arw_rad_per_sqrt_s = 1e-3;
+  noise.accel_vrw_mps_per_sqrt_s = 2e-2;
+  noise.gyro_bias_std_radps = 1e-3;
+  noise.accel_bias_std_mps2 = 0.2;
+  noise.gyro_scale_std = 1e-3;
+  noise.accel_scale_std = 2e-3;
+  noise.correlation_time_s = 300.0;
+  return noise;
+}
+
 TEST(PropagateCovariance, BlockFormEqualsDenseForm) {
   std::mt19937 rng(7);
   std::normal_distribution<double> normal;
   for (const int n : {err::kSize15, err::kSize21}) {
     SCOPED_TRACE(n);
-    InsState x;
-    x.nav.lat_rad = 0.7;
-    x.nav.h_m = 1200.0;
-    x.nav.v_n_mps = Eigen::Vector3d(40.0, -25.0, 3.0);
-    x.nav.q_n_b = QuatFromEuler(0.2, -0.1, 2.5);
-    x.imu.bg_radps = Eigen::Vector3d(1e-4, -2e-4, 3e-4);
-    x.imu.ba_mps2 = Eigen::Vector3d(0.05, -0.02, 0.03);
-    x.imu.sg = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
-    x.imu.sa = Eigen::Vector3d(-1e-3, 3e-3, 2e-3);
-    ImuNoise noise;
-    noise.gyro_arw_rad_per_sqrt_s = 1e-3;
-    noise.accel_vrw_mps_per_sqrt_s = 2e-2;
-    noise.gyro_bias_std_radps = 1e-3;
-    noise.accel_bias_std_mps2 = 0.2;
-    noise.gyro_scale_std = 1e-3;
-    noise.accel_scale_std = 2e-3;
-    noise.correlation_time_s = 300.0;
+    const InsState x = ClimbingTurnState();
+    const ImuNoise noise = PropagationNoise();
     const Eigen::Vector3d f(1.5, -2.0, -9.6), w(0.1, -0.05, 0.2);
     const double dt = 0.02;
     // Scale the random covariance to realistic magnitudes per block (m, m/s, rad, ...).
@@ -439,20 +451,9 @@ TEST(PropagateCovariance, AuxiliaryStatesFollowTheAugmentedDenseForm) {
   std::mt19937 rng(11);
   std::normal_distribution<double> normal;
   const int n = err::kSize15, n_aux = 2, total = n + n_aux;
-  InsState x;
-  x.nav.lat_rad = -0.5;
-  x.nav.h_m = 80.0;
-  x.nav.v_n_mps = Eigen::Vector3d(12.0, 4.0, -0.2);
-  x.nav.q_n_b = QuatFromEuler(0.02, -0.03, 1.1);
-  x.imu.bg_radps = Eigen::Vector3d(2e-5, -1e-5, 3e-5);
-  x.imu.ba_mps2 = Eigen::Vector3d(0.01, -0.02, 0.005);
-  ImuNoise noise;
-  noise.gyro_arw_rad_per_sqrt_s = 1e-4;
-  noise.accel_vrw_mps_per_sqrt_s = 2e-3;
-  noise.gyro_bias_std_radps = 5e-5;
-  noise.accel_bias_std_mps2 = 0.02;
-  noise.correlation_time_s = 600.0;
-  const Eigen::Vector3d f(0.5, 1.0, -9.8), w(0.0, 0.01, 0.3);
+  const InsState x = ClimbingTurnState();
+  const ImuNoise noise = PropagationNoise();
+  const Eigen::Vector3d f(1.5, -2.0, -9.6), w(0.1, -0.05, 0.2);
   const double dt = 0.02;
   const Eigen::VectorXd aux_psd = Eigen::Vector2d(1e-6, 0.0);
   Eigen::VectorXd s(total);
