@@ -167,10 +167,6 @@ std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* confi
   } else {
     *config = files->kfgins_config.empty() ? gnss_ins::LoadObginsConfig(files->obgins_config)
                                            : gnss_ins::LoadKfginsConfig(files->kfgins_config);
-    // OB_GINS' odometer is a column of its IMU file: it follows --imu.
-    if (!config->odometer.file.empty() && config->odometer.file == config->imu_path && !files->imu.empty()) {
-      config->odometer.file = files->imu;
-    }
     if (files->imu.empty()) files->imu = config->imu_path;
     if (files->gnss.empty()) files->gnss = config->gnss_path;
     if (files->out.empty()) files->out = config->output_path;

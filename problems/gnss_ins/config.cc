@@ -546,6 +546,7 @@ void ObginsVehicle(const ConfigNode& root, GnssInsConfig* c) {
   }
   const Eigen::Vector3d std = KfSigmaVector(odo, "std", true);
   c->odometer.file = c->imu_path;
+  c->odometer.from_imu_file = true;
   c->odometer.std_mps = std[0];
   c->odometer.scale_std = odo.NonNegative("srw", 100.0) * kPpm;
   c->nhc.enabled = true;

@@ -165,6 +165,19 @@ std::vector<MagSample> ReadMag(const std::string& path, const std::string& calib
   return out;
 }
 
+/// Odometer speeds inside [t_begin, t_end]; none there is an InputError.
+std::vector<OdometerSample> ReadOdometerSpan(const std::string& path, double t_begin, double t_end) {
+  std::vector<OdometerSample> out;
+  for (const OdometerSample& s : ReadOdometer(path)) {
+    if (s.t_s >= t_begin - kTimeTol_s && s.t_s <= t_end + kTimeTol_s) out.push_back(s);
+  }
+  if (out.empty()) {
+    throw InputError(path, 0, "t", "no odometer sample inside the IMU record [" + Num(t_begin) + ", " +
+                                       Num(t_end) + "] s");
+  }
+  return out;
+}
+
 std::vector<BaroSample> ReadBaro(const std::string& path, double t_begin, double t_end) {
   auto reader = OpenBaro(path);
   std::vector<BaroSample> out;
@@ -248,6 +261,9 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
 
   if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, mag_calibration, t_begin, t_end);
   if (!paths.baro.empty()) in.baro = ReadBaro(paths.baro, t_begin, t_end);
+  if (config.odometer.enabled()) {
+    in.odometer = ReadOdometerSpan(config.odometer.from_imu_file ? paths.imu : config.odometer.file, t_begin, t_end);
+  }
   return in;
 }
 

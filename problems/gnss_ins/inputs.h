@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/types.h"
+#include "core/io/csv_odometer.h"
 #include "problems/gnss_ins/config.h"
 
 namespace navtwin::gnss_ins {
@@ -27,6 +28,8 @@ struct Inputs {
   std::vector<GnssSample> gnss;   ///< strictly increasing; injected outages removed
   std::vector<MagSample> mag;     ///< raw (calibration is applied by the models' users)
   std::vector<BaroSample> baro;   ///< with altitude_m
+  /// Wheel-odometer speeds (config.odometer: its file, or the IMU file's column).
+  std::vector<OdometerSample> odometer;
   std::size_t bridged_imu_gaps = 0;
   std::size_t gnss_removed_by_outages = 0;
   /// The injected outage intervals [start, end) in time (empty without outages).

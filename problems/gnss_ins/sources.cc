@@ -23,7 +23,9 @@ ins::AidingSources MakeSources(const Inputs& inputs, const GnssInsConfig& config
   sources.push_back(ins::MakeBaroSource(inputs.baro, config.baro, std::move(fix_times_s)));
   sources.push_back(ins::MakeZuptSource(config.zupt));
   if (config.nhc.enabled) sources.push_back(ins::MakeNhcSource(config.nhc, config.vehicle, config.zupt));
-  if (!config.odometer.file.empty()) sources.push_back(ins::MakeOdometerSource(config.odometer, config.vehicle));
+  if (config.odometer.enabled()) {
+    sources.push_back(ins::MakeOdometerSource(inputs.odometer, config.odometer, config.vehicle));
+  }
   return sources;
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <vector>
 
-#include "core/io/open.h"
 #include "core/rotation.h"
 #include "factors/odometer_speed.h"
 #include "problems/ins/association.h"
@@ -15,12 +14,13 @@ const char* const kOdometer = "odometer";
 
 class OdometerSource : public AidingSource {
  public:
-  OdometerSource(const OdometerConfig& config, const VehicleConfig& vehicle)
+  OdometerSource(const std::vector<OdometerSample>& samples, const OdometerConfig& config,
+                 const VehicleConfig& vehicle)
       : config_(config),
         lever_b_m_(vehicle.lever_arm_b_m),
         R_v_b_(DcmFromEuler<double>(vehicle.mounting_rpy_rad[0], vehicle.mounting_rpy_rad[1],
                                     vehicle.mounting_rpy_rad[2])),
-        samples_(ReadOdometer(config.file)) {
+        samples_(samples) {
     times_.reserve(samples_.size());
     for (const OdometerSample& s : samples_) times_.push_back(s.t_s);
   }
@@ -60,14 +60,15 @@ class OdometerSource : public AidingSource {
   OdometerConfig config_;
   Eigen::Vector3d lever_b_m_;
   Eigen::Matrix3d R_v_b_;
-  std::vector<OdometerSample> samples_;
+  const std::vector<OdometerSample>& samples_;
   std::vector<double> times_;
 };
 
 }  // namespace
 
-std::unique_ptr<AidingSource> MakeOdometerSource(const OdometerConfig& config, const VehicleConfig& vehicle) {
-  return std::make_unique<OdometerSource>(config, vehicle);
+std::unique_ptr<AidingSource> MakeOdometerSource(const std::vector<OdometerSample>& samples,
+                                                 const OdometerConfig& config, const VehicleConfig& vehicle) {
+  return std::make_unique<OdometerSource>(samples, config, vehicle);
 }
 
 }  // namespace navtwin::ins

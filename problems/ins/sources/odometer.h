@@ -7,7 +7,9 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "core/io/csv_odometer.h"
 #include "problems/ins/aiding.h"
 #include "problems/ins/sources/nhc.h"
 
@@ -15,13 +17,18 @@ namespace navtwin::ins {
 
 struct OdometerConfig {
   /// t_s,speed_mps or t_s,distance_m (core/io/csv_odometer.h), or an OB_GINS IMU file
-  /// with the odometer column (core/io/kfgins.h); empty: off.
+  /// with the odometer column (core/io/kfgins.h); empty: off unless from_imu_file.
   std::string file;
+  /// The odometer is the column of the run's IMU file (OB_GINS), whatever file says.
+  bool from_imu_file = false;
   double std_mps = 0.1;     ///< speed noise
   double scale_std = 0.01;  ///< prior std of the scale-factor error (0: held at 0)
+
+  bool enabled() const { return from_imu_file || !file.empty(); }
 };
 
-/// Count key "odometer". Reads config.file (InputError naming file, line and field).
-std::unique_ptr<AidingSource> MakeOdometerSource(const OdometerConfig& config, const VehicleConfig& vehicle);
+/// Count key "odometer"; samples: the record's speeds, read once with the other inputs.
+std::unique_ptr<AidingSource> MakeOdometerSource(const std::vector<OdometerSample>& samples,
+                                                 const OdometerConfig& config, const VehicleConfig& vehicle);
 
 }  // namespace navtwin::ins
