@@ -33,9 +33,8 @@ class NhcSource : public AidingSource {
 
   void FilterEpoch(FilterAccess& filter) override {
     const double t_s = filter.time_s();
-    if (Standing(filter.still(), filter.nominal().nav.v_n_mps) || t_s - last_s_ < config_.interval_s - kSameEpoch_s) {
-      return;
-    }
+    if (t_s - last_s_ < config_.interval_s - kSameEpoch_s) return;
+    if (Standing(filter.still(), filter.nominal().nav.v_n_mps)) return;
     last_s_ = t_s;
     filter.Update(std::unique_ptr<ceres::CostFunction>(Create(filter.omega_ib_b_radps())),
                   {StateBlock::Velocity(), StateBlock::Attitude()}, kNhc);
