@@ -33,18 +33,6 @@ using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, 
 
 
 
-/// Entries of a folder other than . and .. (none when it does not exist).
-std::vector<std::string> Entries(const std::string& dir) {
-  std::vector<std::string> names;
-  DIR* d = ::opendir(dir.c_str());
-  if (d == nullptr) return names;
-  while (const dirent* e = ::readdir(d)) {
-    const std::string n = e->d_name;
-    if (n != "." && n != "..") names.push_back(n);
-  }
-  ::closedir(d);
-  return names;
-}
 
 
 // ---------------------------------------------------------------------------------------

@@ -28,17 +28,6 @@ std::string MakeTempDir(const std::string& tag) {
   return dir;
 }
 
-std::vector<std::string> Entries(const std::string& dir) {
-  std::vector<std::string> names;
-  DIR* d = ::opendir(dir.c_str());
-  if (d == nullptr) return names;
-  while (const dirent* e = ::readdir(d)) {
-    const std::string n = e->d_name;
-    if (n != "." && n != "..") names.push_back(n);
-  }
-  ::closedir(d);
-  return names;
-}
 
 /// 20 s of a level, north-facing, static IMU at 100 Hz (gravity and Earth rate, no errors),
 /// 1 Hz GNSS at its position (with zero_sigma, the fix at 10 s has a zero sigma), and a
@@ -132,7 +121,7 @@ TEST(GnssInsRun, BadInputLeavesTheFolderEmpty) {
   const Record r = WriteRecord("bad", /*zero_sigma=*/true);
   const std::string out = MakeTempDir("bad_out");
   EXPECT_THROW(RunGnssIns(Options(r, out, RunMethods::kFilterRts), LoadGnssInsConfig(r.config)), InputError);
-  EXPECT_TRUE(Entries(out).empty());
+  EXPECT_TRUE(static_record::Entries(out).empty());
 }
 
 }  // namespace

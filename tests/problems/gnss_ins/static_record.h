@@ -1,11 +1,15 @@
 // A tiny GNSS/INS record for the run and command tests: 20 s of a level, north-facing,
 // static IMU at 100 Hz (gravity and Earth rate, no errors) at 30 N 114 E, 20 m, 1 Hz GNSS
-// at its position, and a navtwin configuration starting from the known state.
+// at its position, and a navtwin configuration starting from the known state; and the
+// listing of an output folder (a failed run must leave nothing).
 #pragma once
 
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
+
+#include <dirent.h>
 
 #include "core/earth.h"
 #include "core/units.h"
@@ -47,6 +51,19 @@ inline std::string ConfigYaml() {
          "  velocity_mps: [0, 0, 0]\n"
          "  attitude_deg: [0, 0, 0]\n"
          "  attitude_std_deg: [0.5, 0.5, 2]\n";
+}
+
+/// Entries of a folder other than . and .. (none when it does not exist).
+inline std::vector<std::string> Entries(const std::string& dir) {
+  std::vector<std::string> names;
+  DIR* d = ::opendir(dir.c_str());
+  if (d == nullptr) return names;
+  while (const dirent* e = ::readdir(d)) {
+    const std::string n = e->d_name;
+    if (n != "." && n != "..") names.push_back(n);
+  }
+  ::closedir(d);
+  return names;
 }
 
 }  // namespace navtwin::static_record
