@@ -13,7 +13,7 @@
 #include "tests/apps/cli_util.h"
 
 namespace navtwin::cli_test {
-namespace {
+namespace apps_calibrate_imu_test {
 
 const std::string kDocs = std::string(NAVTWIN_SOURCE_DIR) + "/docs/calibration/";
 
@@ -175,5 +175,5 @@ TEST(CalibrateImuTest, RefusalsExitNonZeroAndWriteNothing) {
   EXPECT_NE(typo.err.find("latitud_deg"), std::string::npos) << typo.err;
 }
 
-}  // namespace
+}  // namespace apps_calibrate_imu_test
 }  // namespace navtwin::cli_test

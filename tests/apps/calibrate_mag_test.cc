@@ -17,7 +17,7 @@
 #include "core/calibration_file.h"
 
 namespace navtwin {
-namespace {
+namespace apps_calibrate_mag_test {
 
 using namespace cli_test;  // RunResult, Navtwin, MakeTempDir, JsonNumberAfter, Exists
 
@@ -221,5 +221,5 @@ TEST_F(CalibrateMagTest, BadInputNamesFileLineAndFieldAndWritesNothing) {
   EXPECT_FALSE(Exists(out));
 }
 
-}  // namespace
+}  // namespace apps_calibrate_mag_test
 }  // namespace navtwin

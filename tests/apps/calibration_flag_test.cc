@@ -11,7 +11,7 @@
 #include "tests/apps/cli_util.h"
 
 namespace navtwin {
-namespace {
+namespace apps_calibration_flag_test {
 
 using namespace cli_test;  // RunResult, Navtwin, MakeTempDir, JsonNumberAfter
 
@@ -73,5 +73,5 @@ TEST_F(CalibrationFlagTest, InsAppliesTheImuSectionAndRejectsBadFiles) {
   EXPECT_NE(mag_only.err.find("no imu section"), std::string::npos) << mag_only.err;
 }
 
-}  // namespace
+}  // namespace apps_calibration_flag_test
 }  // namespace navtwin

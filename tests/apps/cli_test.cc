@@ -19,7 +19,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace apps_cli_test {
 
 using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
@@ -229,5 +229,5 @@ TEST(Cli, AllanReadsBackTheSimulatedNoise) {
   EXPECT_NEAR(JsonNumberAfter(r.out, "\"gx\"", "arw_deg_sqrt_h"), 0.1, 0.01) << r.out;
 }
 
-}  // namespace
+}  // namespace apps_cli_test
 }  // namespace navtwin

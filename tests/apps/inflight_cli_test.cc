@@ -16,7 +16,7 @@
 #include "tests/apps/cli_util.h"
 
 namespace navtwin {
-namespace {
+namespace apps_inflight_cli_test {
 
 using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
@@ -133,5 +133,5 @@ TEST(InflightCliTest, MonteCarloOfTwoRuns) {
   ::rmdir(dir.c_str());
 }
 
-}  // namespace
+}  // namespace apps_inflight_cli_test
 }  // namespace navtwin

@@ -13,7 +13,7 @@
 #include "core/io/csv_imu.h"
 
 namespace navtwin {
-namespace {
+namespace apps_level_cli_test {
 
 using namespace cli_test;  // RunResult, Navtwin, MakeTempDir, JsonNumberAfter
 
@@ -176,5 +176,5 @@ TEST_F(LevelCliTest, RealMotorsOffWindowsAgreeWithTheWholeSegment) {
   }
 }
 
-}  // namespace
+}  // namespace apps_level_cli_test
 }  // namespace navtwin

@@ -13,7 +13,7 @@
 #include "tests/apps/cli_util.h"
 
 namespace navtwin {
-namespace {
+namespace apps_level_mc_cli_test {
 
 using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
@@ -95,5 +95,5 @@ TEST(LevelMcCliTest, FailedRunLeavesNoCsv) {
   ::rmdir(dir.c_str());
 }
 
-}  // namespace
+}  // namespace apps_level_mc_cli_test
 }  // namespace navtwin

@@ -24,7 +24,7 @@
 #include "core/earth.h"
 
 namespace navtwin {
-namespace {
+namespace apps_navigate_cli_test {
 
 using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
@@ -283,5 +283,5 @@ TEST(NavigateCli, SmoothDemoMeetsTheSeedFigures) {
   EXPECT_NE(ReadAll(dir + "/summary.json").find("\"output_method\":\"batch\""), std::string::npos);
 }
 
-}  // namespace
+}  // namespace apps_navigate_cli_test
 }  // namespace navtwin

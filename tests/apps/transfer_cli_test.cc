@@ -14,7 +14,7 @@
 #include "tests/apps/cli_util.h"
 
 namespace navtwin {
-namespace {
+namespace apps_transfer_cli_test {
 
 using namespace cli_test;  // RunResult, Navtwin, ReadAll, MakeTempDir, Exists, JsonNumberAfter
 
@@ -147,5 +147,5 @@ TEST(TransferCliTest, MalformedMasterFileNamesFileAndLine) {
   EXPECT_TRUE(r.out.empty()) << r.out;  // no partial output
 }
 
-}  // namespace
+}  // namespace apps_transfer_cli_test
 }  // namespace navtwin

@@ -11,7 +11,7 @@
 #include "core/sim/random.h"
 
 namespace navtwin {
-namespace {
+namespace core_allan_test {
 
 constexpr double kTau0_s = 0.01;                    // 100 Hz
 constexpr std::size_t kHour = 360000;               // 1 h of 100 Hz samples
@@ -190,5 +190,5 @@ TEST(Allan, ImuRatesRejectBadInput) {
   EXPECT_THROW(ImuRates(imu, {0}), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace core_allan_test
 }  // namespace navtwin

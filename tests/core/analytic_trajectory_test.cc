@@ -7,7 +7,7 @@
 #include "tests/core/sim/round_trip.h"
 
 namespace navtwin::sim {
-namespace {
+namespace core_analytic_trajectory_test {
 
 // The mechanization on the exact increments of the demo flight must reproduce the truth:
 // this checks the synthesis and the strapdown against each other over 1 h of manoeuvres
@@ -35,5 +35,5 @@ TEST(AnalyticTrajectory, SpecificForceAtRestIsMinusGravity) {
   EXPECT_NEAR((k.omega_ib_b_radps - wgs84::EarthRateNed(0.3)).norm(), 0.0, 1e-18);
 }
 
-}  // namespace
+}  // namespace core_analytic_trajectory_test
 }  // namespace navtwin::sim

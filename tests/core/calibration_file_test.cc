@@ -17,7 +17,7 @@
 #include "core/io/open.h"
 
 namespace navtwin {
-namespace {
+namespace core_calibration_file_test {
 
 using Triad = Eigen::Matrix<double, kTriadParameters, 1>;
 using GSens = Eigen::Matrix<double, kGSensitivityParameters, 1>;
@@ -330,5 +330,5 @@ TEST_F(CalibrationFileTest, OpenOverloadsApplyTheFile) {
   EXPECT_THROW(OpenMag(mag_path, cal), InputError);
 }
 
-}  // namespace
+}  // namespace core_calibration_file_test
 }  // namespace navtwin

@@ -7,7 +7,7 @@
 #include "core/rotation.h"
 
 namespace navtwin::wgs84 {
-namespace {
+namespace core_earth_test {
 
 TEST(Earth, DerivedConstantsMatchTr8350) {
   // NIMA TR8350.2 Table 3.3: b = 6356752.3142 m, e^2 = 6.69437999014e-3 (values printed
@@ -81,5 +81,5 @@ TEST(Earth, LocalNedRoundTripAndDirections) {
   EXPECT_LT(R.col(2).dot(GeodeticToEcef(o.lat_rad, o.lon_rad, o.h_m)), 0.0);
 }
 
-}  // namespace
+}  // namespace core_earth_test
 }  // namespace navtwin::wgs84

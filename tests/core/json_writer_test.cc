@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 namespace navtwin {
-namespace {
+namespace core_json_writer_test {
 
 TEST(JsonWriter, NestedObjectsArraysAndEscapes) {
   std::ostringstream out;
@@ -19,5 +19,5 @@ TEST(JsonWriter, NestedObjectsArraysAndEscapes) {
             R"({"name":"a\"b\\c\n","n":3,"x":0.25,"list":[1,null],"inner":{"ok":true}})");
 }
 
-}  // namespace
+}  // namespace core_json_writer_test
 }  // namespace navtwin

@@ -9,7 +9,7 @@
 #include "core/units.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace core_leveling_model_test {
 
 
 TEST(LevelingModelTest, EquationOneInvertsTheModelInEveryQuadrant) {
@@ -67,5 +67,5 @@ TEST(LevelingModelTest, SpecificForceJacobianMatchesCentralDifferences) {
   }
 }
 
-}  // namespace
+}  // namespace core_leveling_model_test
 }  // namespace navtwin::leveling

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 namespace navtwin {
-namespace {
+namespace core_rotation_test {
 
 // Round trips through exp/log and the conversions lose a few ulps per operation;
 // 1e-12 on unit-scale quantities leaves a margin of ~1000 ulps.
@@ -205,5 +205,5 @@ TEST(Rotation, RightJacobianAndItsInverseMatchCentralDifferences) {
   EXPECT_LT((RightJacobianInverseSO3(below) - RightJacobianInverseSO3(above)).norm(), 1e-5);
 }
 
-}  // namespace
+}  // namespace core_rotation_test
 }  // namespace navtwin

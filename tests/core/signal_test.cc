@@ -9,7 +9,7 @@
 #include "core/units.h"
 
 namespace navtwin::signal {
-namespace {
+namespace core_signal_test {
 
 
 std::vector<Eigen::Vector3d> Sinusoid(int n, double period_samples, double amplitude, double phase,
@@ -155,5 +155,5 @@ TEST(SignalTest, InterpolatedAverageOverAFractionalPeriod) {
   EXPECT_THROW(AverageInterpolated(x, 50.0, 20.0), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace core_signal_test
 }  // namespace navtwin::signal

@@ -8,7 +8,7 @@
 #include "core/rotation.h"
 
 namespace navtwin {
-namespace {
+namespace core_strapdown_test {
 
 // Exact increments of an IMU at rest on the Earth at (lat, h) with attitude R_n_b:
 // the body turns with the Earth (omega_ib_b = R_b_n omega_ie_n, constant in body axes)
@@ -158,5 +158,5 @@ TEST(Strapdown, RejectsNonPositiveInterval) {
   EXPECT_THROW(ins.Update(s), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace core_strapdown_test
 }  // namespace navtwin

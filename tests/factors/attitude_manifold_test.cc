@@ -15,7 +15,7 @@
 #include "core/rotation.h"
 
 namespace navtwin {
-namespace {
+namespace factors_attitude_manifold_test {
 
 using Vec4 = Eigen::Vector4d;  // quaternion coefficients (x, y, z, w)
 using Mat43 = Eigen::Matrix<double, 4, 3, Eigen::RowMajor>;
@@ -167,5 +167,5 @@ TEST(AttitudeManifold, CeresManifoldInvariantsHold) {
   }
 }
 
-}  // namespace
+}  // namespace factors_attitude_manifold_test
 }  // namespace navtwin

@@ -13,7 +13,7 @@
 #include "tests/factors/factor_test_util.h"
 
 namespace navtwin {
-namespace {
+namespace factors_attitude_prior_test {
 
 using testing::Jacobian34;
 using testing::Jacobian43;
@@ -76,5 +76,5 @@ TEST(AttitudePrior, RejectsInvalidArguments) {
   EXPECT_THROW(AttitudePrior(Eigen::Quaterniond::Identity(), nan_matrix), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_attitude_prior_test
 }  // namespace navtwin

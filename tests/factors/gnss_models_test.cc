@@ -25,7 +25,7 @@
 #include "tests/factors/tangent_jacobian_check.h"
 
 namespace navtwin {
-namespace {
+namespace factors_gnss_models_test {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
@@ -173,5 +173,5 @@ TEST(GnssVelocity, RejectsBadSigma) {
   EXPECT_THROW(GnssVelocity(z, z, Eigen::Vector3d(0, kInf, 0), 1.0), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_gnss_models_test
 }  // namespace navtwin

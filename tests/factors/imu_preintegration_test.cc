@@ -28,7 +28,7 @@
 #include "factors/position_manifold.h"
 
 namespace navtwin {
-namespace {
+namespace factors_imu_preintegration_test {
 
 // ---------------------------------------------------------------------------------------
 // Trajectories.
@@ -594,5 +594,5 @@ TEST(ImuPreintegration, RejectsBadInput) {
   EXPECT_EQ(f->num_residuals(), 9);
 }
 
-}  // namespace
+}  // namespace factors_imu_preintegration_test
 }  // namespace navtwin

@@ -25,7 +25,7 @@
 #include "tests/factors/tangent_jacobian_check.h"
 
 namespace navtwin {
-namespace {
+namespace factors_mag_models_test {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
@@ -239,5 +239,5 @@ TEST(MagHeading, RejectsBadSigma) {
   EXPECT_THROW(MagHeading2Axis(kInf, 1.0, 0.0, 0.1), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_mag_models_test
 }  // namespace navtwin

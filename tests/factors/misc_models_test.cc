@@ -26,7 +26,7 @@
 #include "tests/factors/tangent_jacobian_check.h"
 
 namespace navtwin {
-namespace {
+namespace factors_misc_models_test {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
@@ -188,5 +188,5 @@ TEST(StatePrior, RejectsBadSigma) {
   EXPECT_THROW(PositionPrior(Eigen::Vector3d(kNaN, 0, 0), 1.0), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_misc_models_test
 }  // namespace navtwin

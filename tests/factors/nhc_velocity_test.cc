@@ -20,7 +20,7 @@
 #include "tests/factors/tangent_jacobian_check.h"
 
 namespace navtwin {
-namespace {
+namespace factors_nhc_velocity_test {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
@@ -95,5 +95,5 @@ TEST(NhcVelocity, RejectsBadInput) {
                std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_nhc_velocity_test
 }  // namespace navtwin

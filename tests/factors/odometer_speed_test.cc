@@ -19,7 +19,7 @@
 #include "tests/factors/tangent_jacobian_check.h"
 
 namespace navtwin {
-namespace {
+namespace factors_odometer_speed_test {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 
@@ -75,5 +75,5 @@ TEST(OdometerSpeed, RejectsBadInput) {
   EXPECT_THROW(OdometerSpeed(I, z, z, std::nan(""), 1.0), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_odometer_speed_test
 }  // namespace navtwin

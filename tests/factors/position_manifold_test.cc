@@ -17,7 +17,7 @@
 #include "core/units.h"
 
 namespace navtwin {
-namespace {
+namespace factors_position_manifold_test {
 
 using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
@@ -165,5 +165,5 @@ TEST(PositionManifold, TemplatedFunctionsWorkWithJets) {
   }
 }
 
-}  // namespace
+}  // namespace factors_position_manifold_test
 }  // namespace navtwin

@@ -13,7 +13,7 @@
 #include "tests/factors/factor_test_util.h"
 
 namespace navtwin {
-namespace {
+namespace factors_vector_direction_test {
 
 using testing::Jacobian34;
 using testing::Jacobian43;
@@ -77,5 +77,5 @@ TEST(VectorDirection, RejectsInvalidSigma) {
                std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace factors_vector_direction_test
 }  // namespace navtwin

@@ -18,7 +18,7 @@
 #include "factors/vector_direction.h"
 
 namespace navtwin {
-namespace {
+namespace solvers_batch_driver_test {
 
 constexpr double kSigma = 0.01;  // noise of each unit-vector component (~rad)
 constexpr int kNumDirections = 20;
@@ -299,5 +299,5 @@ TEST(BatchDriver, RejectsBadArguments) {
   EXPECT_THROW(ComputeTangentCovariance(problem, {}), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace solvers_batch_driver_test
 }  // namespace navtwin

@@ -18,7 +18,7 @@
 #include "solvers/batch_driver.h"
 
 namespace navtwin {
-namespace {
+namespace solvers_block_covariance_test {
 
 using Algorithm = BlockCovarianceOptions::Algorithm;
 
@@ -290,5 +290,5 @@ TEST(BlockCovariance, InvalidRequestsThrow) {
   EXPECT_THROW(ComputeBlockDiagonalCovariance(problem, {&a, &a}), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace solvers_block_covariance_test
 }  // namespace navtwin

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 namespace navtwin {
-namespace {
+namespace solvers_eskf_test {
 
 // Closed-form chi-square CDFs (Abramowitz & Stegun 26.4.4 for odd, 26.4.5 for even
 // degrees of freedom), independent of the incomplete-gamma code under test. Returned as
@@ -191,5 +191,5 @@ TEST(ErrorStateKalmanFilter, RejectsBadInput) {
   EXPECT_EQ(kf.size(), 2);
 }
 
-}  // namespace
+}  // namespace solvers_eskf_test
 }  // namespace navtwin

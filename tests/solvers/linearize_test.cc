@@ -22,7 +22,7 @@
 #include "factors/zero_velocity.h"
 
 namespace navtwin {
-namespace {
+namespace solvers_linearize_test {
 
 using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -173,5 +173,5 @@ TEST(Linearize, RejectsBadArguments) {
   EXPECT_THROW(Linearize(failing, {p.pos.data()}, {nullptr}), std::runtime_error);
 }
 
-}  // namespace
+}  // namespace solvers_linearize_test
 }  // namespace navtwin

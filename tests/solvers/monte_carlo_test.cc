@@ -13,7 +13,7 @@
 #include "core/sim/random.h"
 
 namespace navtwin {
-namespace {
+namespace solvers_monte_carlo_test {
 
 // A run's result: a few normal draws from the run's own stream, like a simulated trial.
 double RunValue(int run) {
@@ -108,5 +108,5 @@ TEST(MonteCarloRunnerTest, ThreadCpuTimeGrowsWithWork) {
   EXPECT_LT(t1 - t0, 1.0);
 }
 
-}  // namespace
+}  // namespace solvers_monte_carlo_test
 }  // namespace navtwin

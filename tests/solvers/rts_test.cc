@@ -11,7 +11,7 @@
 #include "solvers/eskf.h"
 
 namespace navtwin {
-namespace {
+namespace solvers_rts_test {
 
 // 2-D constant-velocity model, state (pE, pN, vE, vN), white-acceleration PSD q:
 //   Phi = [I dt I; 0 I],  Q = q [dt^3/3 I, dt^2/2 I; dt^2/2 I, dt I].
@@ -216,5 +216,5 @@ TEST(RunRts, EmptyAndInconsistentInput) {
   EXPECT_EQ(single.P[0], a.P_post);
 }
 
-}  // namespace
+}  // namespace solvers_rts_test
 }  // namespace navtwin

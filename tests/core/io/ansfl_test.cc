@@ -14,7 +14,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace io_ansfl_test {
 
 using testing::ExpectInputError;
 using testing::MakeTempDir;
@@ -314,5 +314,5 @@ TEST(AnsflRealDataTest, RawDotFilesLoad) {
   }
 }
 
-}  // namespace
+}  // namespace io_ansfl_test
 }  // namespace navtwin

@@ -11,7 +11,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
-namespace {
+namespace io_csv_imu_test {
 
 using testing::ExpectInputError;
 using testing::ReadAllSamples;
@@ -101,5 +101,5 @@ TEST(CsvImuTest, BadRowsNameLineAndField) {
   ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(header_only)); }, {"no samples"});
 }
 
-}  // namespace
+}  // namespace io_csv_imu_test
 }  // namespace navtwin

@@ -15,7 +15,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace io_csv_mag_baro_test {
 
 using testing::ExpectInputError;
 using testing::MakeTempDir;
@@ -188,5 +188,5 @@ TEST(CsvMagBaroTest, OpenDetectsDispatchesAndDescribesBothKinds) {
   EXPECT_EQ(fb.streams[0].fields.size(), 2u);
 }
 
-}  // namespace
+}  // namespace io_csv_mag_baro_test
 }  // namespace navtwin

@@ -11,7 +11,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
-namespace {
+namespace io_csv_odometer_test {
 
 using testing::ExpectInputError;
 using testing::TempFilePath;
@@ -68,5 +68,5 @@ TEST(CsvOdometerTest, BadInputNamesFileLineAndField) {
   bad("one_distance.csv", "t_s,distance_m\n0,0\n", {"distance_m", "no interval"});
 }
 
-}  // namespace
+}  // namespace io_csv_odometer_test
 }  // namespace navtwin

@@ -14,7 +14,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
-namespace {
+namespace io_kfgins_test {
 
 using testing::ExpectInputError;
 using testing::ReadAllSamples;
@@ -237,5 +237,5 @@ TEST(KfginsTest, NavValidation) {
   ExpectInputError([&] { ReadAllSamples(*OpenKfginsNav(week)); }, {"line 1", "field 'week'"});
 }
 
-}  // namespace
+}  // namespace io_kfgins_test
 }  // namespace navtwin

@@ -10,7 +10,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace io_open_test {
 
 using testing::ExpectInputError;
 using testing::MakeTempDir;
@@ -160,5 +160,5 @@ TEST(OpenRealDataTest, DispatchesULogStreams) {
   EXPECT_EQ(DescribeFile(sample).kind, "ulog");
 }
 
-}  // namespace
+}  // namespace io_open_test
 }  // namespace navtwin

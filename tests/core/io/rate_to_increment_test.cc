@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace navtwin {
-namespace {
+namespace io_rate_to_increment_test {
 
 TEST(RateToIncrementTest, FirstSampleOnlyStartsTheSeries) {
   RateToIncrement r;
@@ -90,5 +90,5 @@ TEST(IncrementIntervalsTest, SingleRowHasNoInterval) {
   EXPECT_THROW(iv.Flush(&out), std::logic_error);
 }
 
-}  // namespace
+}  // namespace io_rate_to_increment_test
 }  // namespace navtwin

@@ -12,7 +12,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace io_rtklib_pos_test {
 
 using testing::ExpectInputError;
 using testing::ReadAllSamples;
@@ -166,5 +166,5 @@ TEST(RtklibPosTest, RealWalkSolutionFile) {
   EXPECT_NEAR(g.front().lat_rad * kRadToDeg, 40.0966916, 1e-9);
 }
 
-}  // namespace
+}  // namespace io_rtklib_pos_test
 }  // namespace navtwin

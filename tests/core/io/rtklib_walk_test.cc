@@ -17,7 +17,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace io_rtklib_walk_test {
 
 using testing::ExpectInputError;
 using testing::MakeTempDir;
@@ -218,5 +218,5 @@ TEST(RtklibWalkRealDataTest, ConvertedFileTimeScaleAgainstTheTags) {
   EXPECT_NEAR((raw.back().t_s - sf.back().t_s) * 1e3, 9.9, 1.0);
 }
 
-}  // namespace
+}  // namespace io_rtklib_walk_test
 }  // namespace navtwin

@@ -10,7 +10,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin {
-namespace {
+namespace io_text_reader_test {
 
 using testing::ExpectInputError;
 using testing::WriteTempFile;
@@ -121,5 +121,5 @@ TEST(TextReaderTest, RequireFieldCountNamesBothCounts) {
                    {"line 9", "expected 7 columns, found 6"});
 }
 
-}  // namespace
+}  // namespace io_text_reader_test
 }  // namespace navtwin

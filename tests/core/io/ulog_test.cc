@@ -18,7 +18,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin {
-namespace {
+namespace io_ulog_test {
 
 using testing::ReadAllSamples;
 
@@ -766,5 +766,5 @@ TEST(ULogRealDataTest, MagnetometerBarometerAndGnssSources) {
   EXPECT_LT(mean_norm_uT, 65.0);
 }
 
-}  // namespace
+}  // namespace io_ulog_test
 }  // namespace navtwin

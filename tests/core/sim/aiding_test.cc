@@ -15,7 +15,7 @@
 #include "core/rotation.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_aiding_test {
 
 const wgs84::Geodetic kStart{37.5 * kDegToRad, 127.0 * kDegToRad, 300.0};
 
@@ -640,5 +640,5 @@ TEST(AidingTest, EmitDrawnWritesTheDrawnValuesWithUnits) {
   EXPECT_EQ(y["baro"]["bias_m"].as<double>(), 0.0);
 }
 
-}  // namespace
+}  // namespace sim_aiding_test
 }  // namespace navtwin::sim

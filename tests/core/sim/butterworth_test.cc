@@ -12,7 +12,7 @@
 #include "core/sim/vibration.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_butterworth_test {
 
 // Seed 001: 4th-order Butterworth at 50 Hz sampled at 1.6 kHz.
 constexpr double kCutoffHz = 50.0;
@@ -291,5 +291,5 @@ TEST(AntiAliasDemonstration, ToneAboveNyquistAliasesWithoutTheFilterAndIsAttenua
   }
 }
 
-}  // namespace
+}  // namespace sim_butterworth_test
 }  // namespace navtwin::sim

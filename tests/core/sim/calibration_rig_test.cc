@@ -18,7 +18,7 @@
 #include "core/strapdown.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_calibration_rig_test {
 
 const wgs84::Geodetic kLab{37.45 * kDegToRad, 126.65 * kDegToRad, 40.0};
 
@@ -328,5 +328,5 @@ TEST(CalibrationRigTest, EmitDrawnDescribesTheRig) {
   EXPECT_DOUBLE_EQ(y[1]["pivot_axis_b"][2].as<double>(), 1.0);  // DNE: the IMU z axis is east
 }
 
-}  // namespace
+}  // namespace sim_calibration_rig_test
 }  // namespace navtwin::sim

@@ -18,7 +18,7 @@
 #include "core/units.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_inertial_errors_test {
 
 
 InertialErrorConfig Parse(const std::string& yaml) {
@@ -498,5 +498,5 @@ TEST(Quantizer, ErrorIsWithinOneQuantumAndDoesNotAccumulate) {
   EXPECT_EQ(Quantizer(0.0).Apply(Eigen::Vector3d(1e-9, 2e-9, 3e-9)), Eigen::Vector3d(1e-9, 2e-9, 3e-9));
 }
 
-}  // namespace
+}  // namespace sim_inertial_errors_test
 }  // namespace navtwin::sim

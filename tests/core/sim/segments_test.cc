@@ -15,7 +15,7 @@
 #include "core/units.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_segments_test {
 
 
 // Every segment kind, ~10 min (590 s). Speeds: 0 -> 30 -> 48 -> 6 -> 0 m/s; heading
@@ -327,5 +327,5 @@ TEST(SegmentTrajectory, ConstructorRejectsAnImpossibleConfiguration) {
   EXPECT_THROW(SegmentTrajectory{config}, std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace sim_segments_test
 }  // namespace navtwin::sim

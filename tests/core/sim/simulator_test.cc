@@ -22,7 +22,7 @@
 #include "core/strapdown.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_simulator_test {
 
 std::string MakeTempDir() {
   std::string tmpl = ::testing::TempDir() + "navtwin_sim_XXXXXX";
@@ -301,5 +301,5 @@ TEST(Simulator, BadScenarioNamesFileLineAndKey) {
   RemoveDir(dir);
 }
 
-}  // namespace
+}  // namespace sim_simulator_test
 }  // namespace navtwin::sim

@@ -11,7 +11,7 @@
 #include "core/rotation.h"
 
 namespace navtwin::sim {
-namespace {
+namespace sim_vibration_test {
 
 // Two groups: a seed-000-like rotor tone on all axes with two harmonics, and a fixed
 // angular tone on y and z whose second harmonic reaches 420 Hz.
@@ -331,5 +331,5 @@ TEST(Vibration, EmitDrawnListsEveryTone) {
   }
 }
 
-}  // namespace
+}  // namespace sim_vibration_test
 }  // namespace navtwin::sim

@@ -11,7 +11,7 @@
 #include "core/sim/random.h"
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_imu_calibration_residuals_test {
 
 using J12 = Eigen::Matrix<double, 3, kTriadParameters, Eigen::RowMajor>;
 using J9 = Eigen::Matrix<double, 3, kGSensitivityParameters, Eigen::RowMajor>;
@@ -79,5 +79,5 @@ TEST(StaticResidualsTest, ZeroAtTheTrueParameters) {
   EXPECT_LT(r.norm(), 1e-9);
 }
 
-}  // namespace
+}  // namespace calibration_imu_calibration_residuals_test
 }  // namespace navtwin::calibration

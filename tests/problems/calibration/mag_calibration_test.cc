@@ -28,7 +28,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_mag_calibration_test {
 
 constexpr double kField_uT = 50.0;
 constexpr double kInclination_rad = 57.0 * kDegToRad;
@@ -630,11 +630,11 @@ TEST(RealData, Px4UlogMagnetometer) {
   }
 }
 
-}  // namespace
+}  // namespace calibration_mag_calibration_test
 }  // namespace navtwin::calibration
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_mag_calibration_test {
 
 TEST(FieldMagnitudeSpread, IsThePopulationStdOfTheFieldMagnitude) {
   EXPECT_EQ(FieldMagnitudeSpread_uT({}), 0.0);
@@ -651,5 +651,5 @@ TEST(FieldMagnitudeSpread, IsThePopulationStdOfTheFieldMagnitude) {
   EXPECT_NEAR(FieldMagnitudeSpread_uT(mag), 0.0, 1e-12);
 }
 
-}  // namespace
+}  // namespace calibration_mag_calibration_test
 }  // namespace navtwin::calibration

@@ -15,7 +15,7 @@
 #include <Eigen/LU>
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_mag_ellipsoid_test {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -156,5 +156,5 @@ TEST(MagEllipsoid, RejectsBadArguments) {
   EXPECT_THROW(MagEllipsoid(Eigen::Vector3d(kNaN, 0, 0), 1.0), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace calibration_mag_ellipsoid_test
 }  // namespace navtwin::calibration

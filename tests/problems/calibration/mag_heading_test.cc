@@ -11,7 +11,7 @@
 #include "problems/ins/nav_error.h"
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_mag_heading_test {
 
 NavState StateAt(double t_s, double yaw_rad) {
   NavState s;
@@ -124,5 +124,5 @@ TEST(MagHeadingTest, SampleAttitudesFromNavAccelerometerOrLevel) {
   }
 }
 
-}  // namespace
+}  // namespace calibration_mag_heading_test
 }  // namespace navtwin::calibration

@@ -22,7 +22,7 @@
 #include "core/units.h"
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_multiposition_test {
 
 constexpr double kLat_rad = 45.0 * kDegToRad;
 constexpr double kHeight_m = 100.0;
@@ -490,5 +490,5 @@ TEST(ImuCalibrationReportTest, NamesJsonAndText) {
   EXPECT_NE(text.find("not observable"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace calibration_multiposition_test
 }  // namespace navtwin::calibration

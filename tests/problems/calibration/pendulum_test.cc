@@ -28,7 +28,7 @@
 #include "core/sim/vibration.h"
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_pendulum_test {
 
 
 const wgs84::Geodetic kLab{37.45 * kDegToRad, 126.65 * kDegToRad, 40.0};
@@ -560,5 +560,5 @@ TEST(PendulumCalibrationTest, BadRecordsNameTheKey) {
   }
 }
 
-}  // namespace
+}  // namespace calibration_pendulum_test
 }  // namespace navtwin::calibration

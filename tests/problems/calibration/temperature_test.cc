@@ -38,7 +38,7 @@
 #include "core/units.h"
 
 namespace navtwin::calibration {
-namespace {
+namespace calibration_temperature_test {
 
 
 // ---------------------------------------------------------------------------------------
@@ -882,5 +882,5 @@ TEST_F(TemperatureRecord, WarmUpThroughTheSimulatorFiles) {
   }
 }
 
-}  // namespace
+}  // namespace calibration_temperature_test
 }  // namespace navtwin::calibration

@@ -27,7 +27,7 @@
 #include "problems/ins/nav_error.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_batch_test {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
@@ -481,5 +481,5 @@ TEST(RunBatch, RejectsUnusableStartAndConfiguration) {
   EXPECT_THROW(RunBatch(in, c, start, nullptr), std::invalid_argument);  // no ARW
 }
 
-}  // namespace
+}  // namespace gnss_ins_batch_test
 }  // namespace navtwin::gnss_ins

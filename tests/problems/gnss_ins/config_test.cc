@@ -13,7 +13,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_config_test {
 
 using navtwin::testing::ExpectInputError;
 using navtwin::testing::MakeTempDir;
@@ -459,5 +459,5 @@ TEST(KfginsConfig, DataRateCrossCheckedAgainstTheImuFile) {
   EXPECT_NE(err.find("line 6"), std::string::npos) << err;
 }
 
-}  // namespace
+}  // namespace gnss_ins_config_test
 }  // namespace navtwin::gnss_ins

@@ -14,7 +14,7 @@
 #include "core/strapdown.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_densify_test {
 
 constexpr double kDt = 0.01;   // 100 Hz
 constexpr int kSamples = 600;  // 6 s
@@ -201,5 +201,5 @@ TEST(OutputDecimator, EveryEpochAtRateZero) {
   EXPECT_NEAR(taken[1], 0.5328, 1e-12);
 }
 
-}  // namespace
+}  // namespace gnss_ins_densify_test
 }  // namespace navtwin::gnss_ins

@@ -32,7 +32,7 @@
 #include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_filter_test {
 
 // The aided-INS layer's measurement rules (problems/ins), used by this filter.
 using ins::CalibrateMag;
@@ -627,5 +627,5 @@ TEST(GnssInsFilter, ResetsToGnssAfterRejectionsInARow) {
   EXPECT_LT(north_offset_at_end(without), kStep_m - 100.0);
 }
 
-}  // namespace
+}  // namespace gnss_ins_filter_test
 }  // namespace navtwin::gnss_ins

@@ -13,7 +13,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_inputs_test {
 
 using navtwin::testing::ExpectInputError;
 using navtwin::testing::MakeTempDir;
@@ -190,5 +190,5 @@ TEST(LoadInputs, BarometerAltitudeFromPressure) {
   ASSERT_EQ(in.mag.size(), 1u);  // the sample at 5 s is after the IMU span
 }
 
-}  // namespace
+}  // namespace gnss_ins_inputs_test
 }  // namespace navtwin::gnss_ins

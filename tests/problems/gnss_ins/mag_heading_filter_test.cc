@@ -25,7 +25,7 @@
 #include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_mag_heading_filter_test {
 
 using namespace test_records;  // SimulateRecord, Vec3, TruthAt
 
@@ -85,5 +85,5 @@ TEST(MagHeadingFilter, LevelFlightHonestSigmaStaysAccurateAndConsistent) {
   EXPECT_LT(worst_ratio, 3.0);
 }
 
-}  // namespace
+}  // namespace gnss_ins_mag_heading_filter_test
 }  // namespace navtwin::gnss_ins

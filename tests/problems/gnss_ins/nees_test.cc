@@ -27,7 +27,7 @@
 #include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_nees_test {
 
 // A 150 s flight with turns, a climb and S-turns, and sensors whose errors the 15-state
 // model covers exactly: constant biases (drawn per run) and white noise, no scale factors,
@@ -155,5 +155,5 @@ TEST(GnssInsFilterNees, FiftyRunsWithinChiSquareBounds) {
   }
 }
 
-}  // namespace
+}  // namespace gnss_ins_nees_test
 }  // namespace navtwin::gnss_ins

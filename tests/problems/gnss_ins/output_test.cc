@@ -17,7 +17,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_output_test {
 
 using navtwin::testing::MakeTempDir;
 using navtwin::testing::ReadAllSamples;
@@ -169,5 +169,5 @@ TEST(WriteJsonFile, WritesAtomically) {
   EXPECT_FALSE(Exists(dir + "/t.json"));
 }
 
-}  // namespace
+}  // namespace gnss_ins_output_test
 }  // namespace navtwin::gnss_ins

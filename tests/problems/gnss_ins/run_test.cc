@@ -19,7 +19,7 @@
 #include "tests/problems/gnss_ins/static_record.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_run_test {
 
 
 std::string MakeTempDir(const std::string& tag) {
@@ -124,5 +124,5 @@ TEST(GnssInsRun, BadInputLeavesTheFolderEmpty) {
   EXPECT_TRUE(static_record::Entries(out).empty());
 }
 
-}  // namespace
+}  // namespace gnss_ins_run_test
 }  // namespace navtwin::gnss_ins

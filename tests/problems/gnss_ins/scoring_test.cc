@@ -14,7 +14,7 @@
 #include "tests/core/io/io_test_util.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_scoring_test {
 
 using navtwin::testing::TempFilePath;
 
@@ -165,5 +165,5 @@ TEST(TrajectoryScorer, SolutionTimesMustIncrease) {
   EXPECT_THROW(scorer->Add(Truth(1.0)), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace gnss_ins_scoring_test
 }  // namespace navtwin::gnss_ins

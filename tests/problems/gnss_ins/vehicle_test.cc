@@ -24,7 +24,7 @@
 #include "tests/problems/gnss_ins/sim_record.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_vehicle_test {
 
 using test_records::TruthAt;
 
@@ -158,5 +158,5 @@ TEST_F(Car, OdometerBoundsTheAlongTrackDriftAndItsScaleFactorIsEstimated) {
   EXPECT_GT(batch.counts.at("odometer").used, 200u);      // at the batch's states
 }
 
-}  // namespace
+}  // namespace gnss_ins_vehicle_test
 }  // namespace navtwin::gnss_ins

@@ -21,7 +21,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin::gnss_ins {
-namespace {
+namespace gnss_ins_walk_test {
 
 using navtwin::testing::DataPath;
 
@@ -109,5 +109,5 @@ TEST(RtklibWalk, HeadingSearchThenFilterRtsAndBatchBridgeOutages) {
   EXPECT_LT(b.outside_v_m, 0.1);
 }
 
-}  // namespace
+}  // namespace gnss_ins_walk_test
 }  // namespace navtwin::gnss_ins

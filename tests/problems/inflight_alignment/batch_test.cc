@@ -33,7 +33,7 @@
 #include "problems/inflight_alignment/distance_heading.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_batch_test {
 
 constexpr double kLat = 36.5 * kDegToRad;
 constexpr double kGpsSigma = 17.0;
@@ -490,5 +490,5 @@ TEST(InflightBatch, RejectsBadInput) {
   }
 }
 
-}  // namespace
+}  // namespace inflight_alignment_batch_test
 }  // namespace navtwin::inflight

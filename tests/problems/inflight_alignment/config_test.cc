@@ -10,7 +10,7 @@
 #include "core/io/input_error.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_config_test {
 
 // Values are compared exactly: each is a short decimal read by yaml-cpp into the nearest
 // double, the same double the literal here gives.
@@ -227,5 +227,5 @@ TEST(InflightConfigTest, RobustLossNames) {
   EXPECT_EQ(ParseInflightConfig("batch: {loss: none}\n", "x.yaml").batch.loss, RobustLoss::kNone);
 }
 
-}  // namespace
+}  // namespace inflight_alignment_config_test
 }  // namespace navtwin::inflight

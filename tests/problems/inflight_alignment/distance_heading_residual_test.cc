@@ -21,7 +21,7 @@
 #include "core/units.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_distance_heading_residual_test {
 
 using tangent_check::Block;
 using tangent_check::ExpectTangentJacobiansMatch;
@@ -290,5 +290,5 @@ TEST(VectorPrior2, ResidualJacobianAndChecks) {
   EXPECT_THROW(VectorPrior2(Eigen::Vector2d(kNaN, 0.0), Eigen::Vector2d::Ones()), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace inflight_alignment_distance_heading_residual_test
 }  // namespace navtwin::inflight

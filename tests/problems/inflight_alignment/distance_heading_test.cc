@@ -22,7 +22,7 @@
 #include "core/units.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_distance_heading_test {
 
 
 // Rotation of a north-east vector by a (from north towards east): heading + a.
@@ -559,5 +559,5 @@ TEST(SeparateHeadingError, RejectsUnusableInput) {
   EXPECT_THROW(SeparateHeadingError(few, prior_without_sigma), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace inflight_alignment_distance_heading_test
 }  // namespace navtwin::inflight

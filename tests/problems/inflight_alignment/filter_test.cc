@@ -26,7 +26,7 @@
 #include "problems/inflight_alignment/inputs.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_filter_test {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -291,5 +291,5 @@ TEST(InflightFilter, RejectsBadInputsAndConfiguration) {
   EXPECT_THROW(RunInflightFilter(Preset(), bad, FilterMethod::kKalman), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace inflight_alignment_filter_test
 }  // namespace navtwin::inflight

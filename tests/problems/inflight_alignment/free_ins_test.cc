@@ -22,7 +22,7 @@
 #include "problems/inflight_alignment/inputs.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_free_ins_test {
 
 
 // The preset with every sensor error off (IMU, GPS, barometer exact) and only the 20 arcmin
@@ -242,5 +242,5 @@ TEST(InflightFreeIns, GpsSigmaSkipsGapsInsteadOfCountingTheMotion) {
   EXPECT_LT(EstimateGpsSigma(fixes), 1e-6);
 }
 
-}  // namespace
+}  // namespace inflight_alignment_free_ins_test
 }  // namespace navtwin::inflight

@@ -16,7 +16,7 @@
 #include "core/sim/truth.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_gps_smoother_test {
 
 constexpr double kGpsSigma_m = 17.0;  // the seed's GPS position error (1 sigma)
 constexpr double kSpeed_mps = 238.0;  // Mach 0.7 at altitude, the seed's cruise
@@ -366,5 +366,5 @@ TEST(GpsSmoother, BadOptionsAreRejected) {
   throws([](GpsSmootherOptions& o) { o.reset_after_rejections = 0; });
 }
 
-}  // namespace
+}  // namespace inflight_alignment_gps_smoother_test
 }  // namespace navtwin::inflight

@@ -13,7 +13,7 @@
 #include "core/rotation.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_monte_carlo_test {
 
 constexpr double kNaN = McRunNumbers::kNaN;
 
@@ -134,5 +134,5 @@ TEST(InflightMonteCarlo, RejectsBadOptions) {
   EXPECT_THROW(RunInflightMonteCarlo(scenario, InflightConfig(), options), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace inflight_alignment_monte_carlo_test
 }  // namespace navtwin::inflight

@@ -23,7 +23,7 @@
 #include "problems/inflight_alignment/inputs.h"
 
 namespace navtwin::inflight {
-namespace {
+namespace inflight_alignment_run_test {
 
 
 NavState StateWithYaw(double t_s, double yaw_deg) {
@@ -268,5 +268,5 @@ TEST(InflightRunTest, WithoutTruthTheErrorsAreUnknownAndWrittenAsNull) {
   EXPECT_NE(json.find("\"heading_error_arcmin_at_km\":{\"10\":null,\"1000\":null}"), std::string::npos) << json;
 }
 
-}  // namespace
+}  // namespace inflight_alignment_run_test
 }  // namespace navtwin::inflight

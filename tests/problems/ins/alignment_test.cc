@@ -11,7 +11,7 @@
 #include "core/units.h"
 
 namespace navtwin::ins {
-namespace {
+namespace ins_alignment_test {
 
 
 // Exact increments of an IMU at rest on the Earth at latitude lat, height 0, attitude R:
@@ -119,5 +119,5 @@ TEST(AttitudeFromGnssVelocity, LevelWithVelocityHeading) {
   EXPECT_THROW(AttitudeFromGnssVelocity(Eigen::Vector3d(0.0, 0.0, 3.0)), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace ins_alignment_test
 }  // namespace navtwin::ins

@@ -16,7 +16,7 @@
 #include "solvers/eskf.h"
 
 namespace navtwin::ins {
-namespace {
+namespace ins_error_dynamics_test {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -480,5 +480,5 @@ TEST(PropagateCovariance, AuxiliaryStatesFollowTheAugmentedDenseForm) {
   EXPECT_THROW(PropagateCovariance(x, f, w, noise, dt, &wrong, nullptr, aux_psd), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace ins_error_dynamics_test
 }  // namespace navtwin::ins

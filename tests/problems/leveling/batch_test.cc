@@ -18,7 +18,7 @@
 #include "tests/problems/leveling/simulated_window.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace leveling_batch_test {
 using namespace test_windows;
 
 // The seed's vibration: body x, 1 g, random phase.
@@ -429,5 +429,5 @@ TEST(LevelingBatchTest, TooFewSamplesIsAClearError) {
   }
 }
 
-}  // namespace
+}  // namespace leveling_batch_test
 }  // namespace navtwin::leveling

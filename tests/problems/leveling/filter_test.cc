@@ -15,7 +15,7 @@
 #include "tests/problems/leveling/simulated_window.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace leveling_filter_test {
 
 constexpr double kG = kStandardGravity_mps2;
 constexpr double kRate_hz = 600.0;
@@ -218,5 +218,5 @@ TEST(LevelingFilterTest, NoSamplesIsAClearError) {
   }
 }
 
-}  // namespace
+}  // namespace leveling_filter_test
 }  // namespace navtwin::leveling

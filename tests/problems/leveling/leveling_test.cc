@@ -13,7 +13,7 @@
 #include "problems/leveling/monte_carlo.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace leveling_leveling_test {
 
 constexpr double kG = kStandardGravity_mps2;
 
@@ -118,5 +118,5 @@ TEST(LevelingTest, TooFewSamplesIsAClearError) {
   }
 }
 
-}  // namespace
+}  // namespace leveling_leveling_test
 }  // namespace navtwin::leveling

@@ -22,7 +22,7 @@
 #include "core/units.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace leveling_leveling_vibration_test {
 
 constexpr double kSigma = 0.49;  // 50 mg
 
@@ -258,5 +258,5 @@ TEST(LevelingVibrationTest, RejectsInvalidArguments) {
   EXPECT_THROW(LevelingVibration({0.0, 0.1}, V{f}, kStandardGravity_mps2, 1.0, 1, false), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace leveling_leveling_vibration_test
 }  // namespace navtwin::leveling

@@ -14,7 +14,7 @@
 #include "core/units.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace leveling_monte_carlo_test {
 
 constexpr double kG = kStandardGravity_mps2;
 
@@ -298,5 +298,5 @@ TEST(LevelingMonteCarloTest, ErrorsAreTakenAgainstATiltedTruthWithRollWrapped) {
   EXPECT_GT(r.methods[0].roll_max_deg, 0.0);
 }
 
-}  // namespace
+}  // namespace leveling_monte_carlo_test
 }  // namespace navtwin::leveling

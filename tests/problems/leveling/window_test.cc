@@ -19,7 +19,7 @@
 #include "core/units.h"
 
 namespace navtwin::leveling {
-namespace {
+namespace leveling_window_test {
 
 constexpr double kG = kStandardGravity_mps2;
 
@@ -260,5 +260,5 @@ TEST(CheckWindowTest, GravityOptionSetsTheReferenceAndZeroMeansStandardGravity) 
   EXPECT_TRUE(CheckWindow(w, options).moving);
 }
 
-}  // namespace
+}  // namespace leveling_window_test
 }  // namespace navtwin::leveling

@@ -16,7 +16,7 @@
 #include "tests/test_data.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_ansfl_test {
 
 using Eigen::Matrix3d;
 using Eigen::Quaterniond;
@@ -270,5 +270,5 @@ TEST(AnsflRepeatability, GroupsPerDotOverAllPathsAndPerFlightType) {
   EXPECT_FALSE(AnsflCoarseOk(runs[4]));
 }
 
-}  // namespace
+}  // namespace transfer_alignment_ansfl_test
 }  // namespace navtwin::transfer

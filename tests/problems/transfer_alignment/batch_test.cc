@@ -20,7 +20,7 @@
 #include "problems/transfer_alignment/run.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_batch_test {
 
 // The preset's sensors and master, 60 s of its first manoeuvres: 10 s cruise, 40 s wing
 // rock (+-30 deg at 0.5 Hz, the largest angular acceleration of the preset), a 45 deg turn.
@@ -121,5 +121,5 @@ TEST(TransferBatch, ShortWingRockScenario) { CheckBatch(ShortInputs(), "short (6
 
 TEST(TransferBatch, PresetSeed1) { CheckBatch(PresetInputs(), "transfer-alignment-high-maneuver, seed 1"); }
 
-}  // namespace
+}  // namespace transfer_alignment_batch_test
 }  // namespace navtwin::transfer

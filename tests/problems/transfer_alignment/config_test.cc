@@ -10,7 +10,7 @@
 #include "core/io/input_error.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_config_test {
 
 // Values are compared exactly: each is a short decimal read by yaml-cpp into the nearest
 // double, the same double the literal here gives. Every value differs from its default.
@@ -133,5 +133,5 @@ TEST(TransferConfigTest, MissingFileIsAnInputErrorNamingIt) {
   }
 }
 
-}  // namespace
+}  // namespace transfer_alignment_config_test
 }  // namespace navtwin::transfer

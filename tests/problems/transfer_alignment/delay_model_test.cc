@@ -10,7 +10,7 @@
 #include "problems/transfer_alignment/filter.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_delay_model_test {
 
 using Jet = ceres::Jet<double, kTransferStates>;
 using Matrix6x10 = Eigen::Matrix<double, 6, kTransferStates>;
@@ -119,5 +119,5 @@ TEST(TransferDelayModel, JacobianAtTruthHasTheFirstOrderForm) {
   }
 }
 
-}  // namespace
+}  // namespace transfer_alignment_delay_model_test
 }  // namespace navtwin::transfer

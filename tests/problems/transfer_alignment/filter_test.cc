@@ -11,7 +11,7 @@
 #include "problems/transfer_alignment/run.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_filter_test {
 
 const TransferInputs& PresetInputs() {
   static const TransferInputs in =
@@ -71,5 +71,5 @@ TEST(TransferFilter, RejectsABadConfiguration) {
   EXPECT_THROW(RunTransferFilter(PresetInputs(), cfg, DelayOrder::kFirst), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace transfer_alignment_filter_test
 }  // namespace navtwin::transfer

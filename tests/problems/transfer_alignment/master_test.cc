@@ -14,7 +14,7 @@
 #include "problems/transfer_alignment/inputs.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_master_test {
 
 const TransferInputs& PresetInputs() {
   static const TransferInputs in =
@@ -201,5 +201,5 @@ TEST(MasterStream, CompensationMismatchOnPreset) {
   EXPECT_LT(rms_vel[1][1], 0.5 * rms_vel[1][0]);
 }
 
-}  // namespace
+}  // namespace transfer_alignment_master_test
 }  // namespace navtwin::transfer

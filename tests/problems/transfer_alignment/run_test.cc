@@ -20,7 +20,7 @@
 #include "problems/transfer_alignment/inputs.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_run_test {
 
 
 NavState StateAt(double t_s, const Eigen::Vector3d& euler_rad) {
@@ -243,5 +243,5 @@ TEST(TransferInputsTest, ValidationNamesTheFileTheRecordAndTheField) {
   EXPECT_THROW(ValidateInputs(in), InputError);
 }
 
-}  // namespace
+}  // namespace transfer_alignment_run_test
 }  // namespace navtwin::transfer

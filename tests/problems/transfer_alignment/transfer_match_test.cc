@@ -20,7 +20,7 @@
 #include "tests/factors/tangent_jacobian_check.h"
 
 namespace navtwin::transfer {
-namespace {
+namespace transfer_alignment_transfer_match_test {
 
 using namespace tangent_check;  // Block, States, ExpectTangentJacobiansMatch, Std
 using transfer::DelayOrder;
@@ -174,5 +174,5 @@ TEST(TransferMatch, RejectsBadArguments) {
   EXPECT_THROW(TransferMatch(bad, 0.0, DelayOrder::kSecond, z, 1e-3, 0.05), std::invalid_argument);
 }
 
-}  // namespace
+}  // namespace transfer_alignment_transfer_match_test
 }  // namespace navtwin::transfer
