@@ -59,7 +59,7 @@ double Number(const ConfigNode& parent, const std::string& key, const YAML::Node
   return x;
 }
 
-Eigen::Vector3d Vector3(const ConfigNode& n, const std::string& key, bool allow_null) {
+Eigen::Vector3d ReadVector3(const ConfigNode& n, const std::string& key, bool allow_null) {
   const YAML::Node seq = n.yaml()[key];
   if (!seq.IsSequence() || seq.size() != 3) n.Fail(key, "expected [x, y, z] (3 numbers)");
   Eigen::Vector3d v;
@@ -67,7 +67,7 @@ Eigen::Vector3d Vector3(const ConfigNode& n, const std::string& key, bool allow_
   return v;
 }
 
-Eigen::Matrix3d Matrix3(const ConfigNode& n, const std::string& key, bool allow_null) {
+Eigen::Matrix3d ReadMatrix3(const ConfigNode& n, const std::string& key, bool allow_null) {
   const YAML::Node rows = n.yaml()[key];
   if (!rows.IsSequence() || rows.size() != 3) n.Fail(key, "expected [[..], [..], [..]] (3 rows of 3 numbers)");
   Eigen::Matrix3d m;
@@ -106,9 +106,9 @@ std::vector<Eigen::Vector3d> Rows(const ConfigNode& n, const std::string& key) {
 Triad ParseTriad(const ConfigNode& n, const std::string& bias_key, bool sigma) {
   const double absent = sigma ? std::numeric_limits<double>::quiet_NaN() : 0.0;
   Triad t = Triad::Constant(absent);
-  if (n.Has("scale_factor")) t.head<3>() = Vector3(n, "scale_factor", sigma);
+  if (n.Has("scale_factor")) t.head<3>() = ReadVector3(n, "scale_factor", sigma);
   if (n.Has("misalignment_rad")) {
-    const Eigen::Matrix3d M = Matrix3(n, "misalignment_rad", sigma);
+    const Eigen::Matrix3d M = ReadMatrix3(n, "misalignment_rad", sigma);
     for (int r = 0; r < 3; ++r) {
       if (M(r, r) != 0.0 && !(sigma && std::isnan(M(r, r)))) {
         n.Fail("misalignment_rad", "diagonal entry (" + std::to_string(r + 1) + ", " + std::to_string(r + 1) +
@@ -119,7 +119,7 @@ Triad ParseTriad(const ConfigNode& n, const std::string& bias_key, bool sigma) {
       }
     }
   }
-  if (n.Has(bias_key)) t.tail<3>() = Vector3(n, bias_key, sigma);
+  if (n.Has(bias_key)) t.tail<3>() = ReadVector3(n, bias_key, sigma);
   return t;
 }
 
@@ -142,7 +142,7 @@ ImuCalibration ParseImu(const ConfigNode& imu) {
   c.gyro = ParseTriad(gyro, "bias_rad_per_s", false);
   c.accel = ParseTriad(accel, "bias_mps2", false);
   if (gyro.Has(kGSensKey)) {
-    const Eigen::Matrix3d G = Matrix3(gyro, kGSensKey, false);
+    const Eigen::Matrix3d G = ReadMatrix3(gyro, kGSensKey, false);
     for (int r = 0; r < 3; ++r)
       for (int k = 0; k < 3; ++k) c.g_sensitivity[3 * r + k] = G(r, k);
   }
@@ -158,7 +158,7 @@ ImuCalibration ParseImu(const ConfigNode& imu) {
     if (sigma.Has("gyro")) c.gyro_sigma = ParseTriad(sg, "bias_rad_per_s", true);
     if (sigma.Has("accel")) c.accel_sigma = ParseTriad(sa, "bias_mps2", true);
     if (sg.Has(kGSensKey)) {
-      const Eigen::Matrix3d G = Matrix3(sg, kGSensKey, true);
+      const Eigen::Matrix3d G = ReadMatrix3(sg, kGSensKey, true);
       GSens g;
       for (int r = 0; r < 3; ++r)
         for (int k = 0; k < 3; ++k) g[3 * r + k] = G(r, k);
@@ -189,10 +189,10 @@ MagCorrection ParseMag(const ConfigNode& mag) {
     mag.Fail("soft_iron", "give the correction once (correction, or soft_iron in older files)");
   }
   MagCorrection m;
-  if (mag.Has("hard_iron_uT")) m.hard_iron_uT = Vector3(mag, "hard_iron_uT", false);
+  if (mag.Has("hard_iron_uT")) m.hard_iron_uT = ReadVector3(mag, "hard_iron_uT", false);
   const char* key = mag.Has("correction") ? "correction" : "soft_iron";
   if (mag.Has(key)) {
-    m.correction = Matrix3(mag, key, false);
+    m.correction = ReadMatrix3(mag, key, false);
     const double det = m.correction.determinant();
     if (!(std::abs(det) >= kMinDeterminant)) {
       mag.Fail(key, "not invertible (determinant " + Num(det) + ")");

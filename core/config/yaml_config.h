@@ -6,6 +6,7 @@
 #pragma once
 
 #include <initializer_list>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@
 #include <yaml-cpp/yaml.h>
 
 namespace navtwin {
+
+/// The `hi` of ConfigNode::Double for a value bounded only below.
+inline constexpr double kNoUpperBound = std::numeric_limits<double>::infinity();
 
 /// A YAML mapping with the file it came from and its key path, for messages.
 class ConfigNode {
@@ -30,7 +34,7 @@ class ConfigNode {
   std::vector<ConfigNode> Elements(const std::string& key) const;
 
   double Double(const std::string& key, double fallback) const;
-  /// Like Double, and throws unless lo <= value <= hi.
+  /// Like Double, and throws unless lo <= value <= hi (hi = kNoUpperBound: none).
   double Double(const std::string& key, double fallback, double lo, double hi) const;
   /// A standard deviation or another scale: finite and > 0 ("must be > 0, got X").
   double Positive(const std::string& key, double fallback) const;

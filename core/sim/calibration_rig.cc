@@ -14,7 +14,6 @@
 namespace navtwin::sim {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Largest table rate accepted (deg/s); beyond any rate table.
 constexpr double kMaxTableRate_deg_s = 1000.0;
 /// Pendulum integration: RK4 steps per interpolation node, and node spacing.
@@ -72,7 +71,7 @@ Eigen::Vector3d DegVector(const ConfigNode& node, const std::string& key) {
 TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
   node.RequireKeys({"euler_deg", "rotate", "rate_deg_s", "duration_s", "ramp_s", "dwell_s"});
   TableStep s;
-  s.dwell_s = node.Double("dwell_s", default_dwell_s, 0.0, kInf);
+  s.dwell_s = node.Double("dwell_s", default_dwell_s, 0.0, kNoUpperBound);
   if (node.Has("euler_deg") == node.Has("rotate")) {
     node.Fail("", "give either euler_deg (a position) or rotate (a rate-table rotation)");
   }
@@ -94,8 +93,8 @@ TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
   if (!node.Has("rate_deg_s")) node.Fail("rate_deg_s", "required for a rotation");
   s.rate_radps =
       node.Double("rate_deg_s", 0.0, -kMaxTableRate_deg_s, kMaxTableRate_deg_s) * kDegToRad;
-  s.duration_s = node.Double("duration_s", 0.0, 0.0, kInf);
-  s.ramp_s = node.Double("ramp_s", s.ramp_s, 0.0, kInf);
+  s.duration_s = node.Double("duration_s", 0.0, 0.0, kNoUpperBound);
+  s.ramp_s = node.Double("ramp_s", s.ramp_s, 0.0, kNoUpperBound);
   if (!(s.ramp_s > 0.0)) node.Fail("ramp_s", "must be > 0 (the angular rate must be continuous)");
   return s;
 }
@@ -103,9 +102,9 @@ TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
 MultiPositionConfig ParseMultiPosition(const ConfigNode& node) {
   node.RequireKeys({"kind", "rotation_s", "dwell_s", "steps"});
   MultiPositionConfig c;
-  c.rotation_s = node.Double("rotation_s", c.rotation_s, 0.0, kInf);
+  c.rotation_s = node.Double("rotation_s", c.rotation_s, 0.0, kNoUpperBound);
   if (!(c.rotation_s > 0.0)) node.Fail("rotation_s", "must be > 0");
-  const double dwell_s = node.Double("dwell_s", 10.0, 0.0, kInf);
+  const double dwell_s = node.Double("dwell_s", 10.0, 0.0, kNoUpperBound);
   for (const ConfigNode& step : node.Elements("steps")) {
     c.steps.push_back(ParseTableStep(step, dwell_s));
   }
@@ -118,9 +117,9 @@ PendulumConfig ParsePendulum(const ConfigNode& node) {
                     "initial_rate_deg_s", "mounting", "mounting_deg", "angle_noise_deg",
                     "angle_quantum_deg"});
   PendulumConfig c;
-  c.length_m = node.Double("length_m", c.length_m, 0.0, kInf);
+  c.length_m = node.Double("length_m", c.length_m, 0.0, kNoUpperBound);
   if (!(c.length_m > 0.0)) node.Fail("length_m", "must be > 0");
-  c.damping_per_s = node.Double("damping_per_s", 0.0, 0.0, kInf);
+  c.damping_per_s = node.Double("damping_per_s", 0.0, 0.0, kNoUpperBound);
   if (node.Has("c2_per_s2")) {
     c.c2_per_s2 = node.Double("c2_per_s2", 0.0);
     if (!(*c.c2_per_s2 > 0.0)) node.Fail("c2_per_s2", "must be > 0");

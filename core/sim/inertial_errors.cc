@@ -11,7 +11,6 @@
 namespace navtwin::sim {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// How one triad's quantities are named and scaled in YAML (parsing and errors.yaml
 /// share this table, so the two cannot disagree). `*_si` converts a YAML value to SI.
@@ -69,7 +68,7 @@ AxisConstant ParseAxisConstant(const ConfigNode& node, const std::string& sigma_
                                const std::string& fixed_key, double si) {
   RequireNotBoth(node, sigma_key, fixed_key);
   AxisConstant c;
-  c.sigma = node.Double(sigma_key, 0.0, 0.0, kInf) * si;
+  c.sigma = node.Double(sigma_key, 0.0, 0.0, kNoUpperBound) * si;
   if (node.Has(fixed_key)) c.fixed = node.Vector(fixed_key, Eigen::Vector3d::Zero()) * si;
   return c;
 }
@@ -78,7 +77,7 @@ MatrixConstant ParseMatrixConstant(const ConfigNode& node, const std::string& si
                                    const std::string& fixed_key, double si) {
   RequireNotBoth(node, sigma_key, fixed_key);
   MatrixConstant c;
-  c.sigma = node.Double(sigma_key, 0.0, 0.0, kInf) * si;
+  c.sigma = node.Double(sigma_key, 0.0, 0.0, kNoUpperBound) * si;
   if (node.Has(fixed_key)) c.fixed = ParseMatrix3(node, fixed_key) * si;
   return c;
 }
@@ -105,19 +104,19 @@ TriadErrorConfig ParseTriad(const ConfigNode& node, const TriadUnits& u) {
                     u.quantum_key.c_str(), "temperature"});
   TriadErrorConfig c;
   c.bias = ParseAxisConstant(node, bias, bias_fixed, u.rate_si);
-  c.bias_instability = node.Double(instability, 0.0, 0.0, kInf) * u.rate_si;
-  c.correlation_time_s = node.Double("correlation_time_s", 0.0, 0.0, kInf);
+  c.bias_instability = node.Double(instability, 0.0, 0.0, kNoUpperBound) * u.rate_si;
+  c.correlation_time_s = node.Double("correlation_time_s", 0.0, 0.0, kNoUpperBound);
   if (c.bias_instability > 0.0 && !(c.correlation_time_s > 0.0)) {
     node.Fail("correlation_time_s", "required (> 0) with " + instability);
   }
-  c.random_walk = node.Double(u.random_walk_key, 0.0, 0.0, kInf) * u.random_walk_si;
-  c.white_noise = node.Double(u.white_key, 0.0, 0.0, kInf) * u.white_si;
+  c.random_walk = node.Double(u.random_walk_key, 0.0, 0.0, kNoUpperBound) * u.random_walk_si;
+  c.white_noise = node.Double(u.white_key, 0.0, 0.0, kNoUpperBound) * u.white_si;
   c.scale_factor = ParseAxisConstant(node, "scale_factor_ppm", "scale_factor_fixed_ppm", kPpm);
   c.misalignment = ParseMatrixConstant(node, "misalignment_arcsec", "misalignment_fixed_arcsec", kArcsec_rad);
   if (c.misalignment.fixed && c.misalignment.fixed->diagonal().cwiseAbs().maxCoeff() > 0.0) {
     node.Fail("misalignment_fixed_arcsec", "the diagonal must be 0 (scale factors are the diagonal)");
   }
-  c.quantum = node.Double(u.quantum_key, 0.0, 0.0, kInf);
+  c.quantum = node.Double(u.quantum_key, 0.0, 0.0, kNoUpperBound);
   ParseTemperatureSensitivity(node.Child("temperature"), u, &c);
   return c;
 }
@@ -129,7 +128,7 @@ TemperatureProfile ParseTemperatureProfile(const ConfigNode& node) {
   p.reference_degC = node.Double("reference_degC", p.reference_degC, kAbsZero_degC, kMax_degC);
   p.initial_degC = node.Double("initial_degC", p.reference_degC, kAbsZero_degC, kMax_degC);
   p.final_degC = node.Double("final_degC", p.initial_degC, kAbsZero_degC, kMax_degC);
-  p.time_constant_s = node.Double("time_constant_s", 0.0, 0.0, kInf);
+  p.time_constant_s = node.Double("time_constant_s", 0.0, 0.0, kNoUpperBound);
   if (p.final_degC != p.initial_degC && !(p.time_constant_s > 0.0)) {
     node.Fail("time_constant_s", "required (> 0) when final_degC differs from initial_degC");
   }

@@ -35,18 +35,16 @@
 #include "problems/gnss_ins/sources.h"
 #include "problems/ins/measurement_rules.h"
 #include "solvers/batch_driver.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
-
-constexpr double kTimeEps_s = ins::kSameEpoch_s;
 
 using ins::AidingSource;
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
-
 
 /// A state epoch and, when the anchoring source placed it, the index of its sample (-1 if none).
 struct PlannedState {
@@ -80,19 +78,19 @@ Plan PlanStates(const std::vector<double>& anchor_times, const GnssInsConfig& co
   std::vector<PlannedState> anchors{{t0_s, -1}};
   for (std::size_t i = 0; i < anchor_times.size(); ++i) {
     const double t = anchor_times[i];
-    if (t < t0_s - kTimeEps_s) continue;
-    if (t > t_end_s + kTimeEps_s) break;
-    if (t <= t0_s + kTimeEps_s) {  // at the first state
+    if (t < t0_s - ins::kSameEpoch_s) continue;
+    if (t > t_end_s + ins::kSameEpoch_s) break;
+    if (t <= t0_s + ins::kSameEpoch_s) {  // at the first state
       anchors.front().anchor = static_cast<long>(i);
       continue;
     }
-    if (thin > 0.0 && t - anchors.back().t_s < thin - kTimeEps_s) {
+    if (thin > 0.0 && t - anchors.back().t_s < thin - ins::kSameEpoch_s) {
       plan.thinned.push_back(i);
       continue;
     }
     anchors.push_back({t, static_cast<long>(i)});
   }
-  if (t_end_s - anchors.back().t_s > max_gap + kTimeEps_s) anchors.push_back({t_end_s, -1});
+  if (t_end_s - anchors.back().t_s > max_gap + ins::kSameEpoch_s) anchors.push_back({t_end_s, -1});
   for (std::size_t i = 0; i < anchors.size(); ++i) {
     plan.states.push_back(anchors[i]);
     if (i + 1 == anchors.size()) break;
@@ -221,7 +219,7 @@ void BatchSmoother::Check() const {
   if (in_.imu.empty()) throw std::invalid_argument("RunBatch: no IMU samples");
   const double t0 = start_.epochs.front().state.nav.t_s;
   const double imu_begin = in_.imu.front().t_s - in_.imu.front().dt_s;
-  if (t0 < imu_begin - kTimeEps_s || t0 >= in_.imu.back().t_s - kTimeEps_s) {
+  if (t0 < imu_begin - ins::kSameEpoch_s || t0 >= in_.imu.back().t_s - ins::kSameEpoch_s) {
     std::ostringstream text;
     text.precision(12);
     text << "RunBatch: the start solution begins at t = " << t0 << " s, outside the IMU record [" << imu_begin
@@ -328,14 +326,14 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     ++si;
   };
   const auto events = [&](double t) {
-    while (kn < knots.size() && knots[kn].state.nav.t_s <= t + kTimeEps_s) {
+    while (kn < knots.size() && knots[kn].state.nav.t_s <= t + ins::kSameEpoch_s) {
       NavState nav = knots[kn].state.nav;
       nav.t_s = strapdown.state().t_s;
       strapdown.SetState(nav);
       errors = knots[kn].state.imu;
       ++kn;
     }
-    while (si < n && states_[si].t_s <= t + kTimeEps_s) record_state();
+    while (si < n && states_[si].t_s <= t + ins::kSameEpoch_s) record_state();
   };
   const auto step = [&](const ImuSample& piece) {
     const ImuSample c = CorrectImu(piece, errors);
@@ -347,24 +345,24 @@ void BatchSmoother::MechanizeAndPreintegrate() {
 
   pre_.assign(n > 0 ? n - 1 : 0, nullptr);
   // The angular rate at t0: of the sample that ends at or contains t0.
-  auto k = std::lower_bound(imu.begin(), imu.end(), t0 - kTimeEps_s,
+  auto k = std::lower_bound(imu.begin(), imu.end(), t0 - ins::kSameEpoch_s,
                             [](const ImuSample& s, double t) { return s.t_s < t; });
   if (k != imu.end()) omega = CorrectImu(*k, errors).dtheta_b_rad / k->dt_s;
   // Samples ending at or before t0 only feed the stillness window.
-  for (auto w = imu.begin(); w != imu.end() && w->t_s <= t0 + kTimeEps_s; ++w) {
+  for (auto w = imu.begin(); w != imu.end() && w->t_s <= t0 + ins::kSameEpoch_s; ++w) {
     if (detector && w->t_s > t0 - still_rule->window_s - 1.0) detector->Add(CorrectImu(*w, errors));
   }
   record_state();
-  k = std::upper_bound(imu.begin(), imu.end(), t0 + kTimeEps_s,
+  k = std::upper_bound(imu.begin(), imu.end(), t0 + ins::kSameEpoch_s,
                        [](double t, const ImuSample& s) { return t < s.t_s; });
   for (; k != imu.end() && si < n; ++k) {
     ImuSample piece = *k;
-    if (piece.t_s - piece.dt_s < t0 - kTimeEps_s) piece = SplitImuSample(piece, t0).second;
+    if (piece.t_s - piece.dt_s < t0 - ins::kSameEpoch_s) piece = SplitImuSample(piece, t0).second;
     while (true) {
       const double next_knot = kn < knots.size() ? knots[kn].state.nav.t_s : INFINITY;
       const double next = std::min(next_knot, states_[si].t_s);
-      if (next >= piece.t_s - kTimeEps_s) break;
-      if (next > piece.t_s - piece.dt_s + kTimeEps_s) {
+      if (next >= piece.t_s - ins::kSameEpoch_s) break;
+      if (next > piece.t_s - piece.dt_s + ins::kSameEpoch_s) {
         const std::pair<ImuSample, ImuSample> parts = SplitImuSample(piece, next);
         step(parts.first);
         piece = parts.second;
@@ -406,7 +404,7 @@ void BatchSmoother::AddPriors() {
     }
   }
   const FilterStart* fs = initial_ != nullptr ? initial_ : (computed ? &*computed : nullptr);
-  if (fs != nullptr && std::abs(fs->state.nav.t_s - states_.front().t_s) <= kTimeEps_s) centre = fs->state;
+  if (fs != nullptr && std::abs(fs->state.nav.t_s - states_.front().t_s) <= ins::kSameEpoch_s) centre = fs->state;
   const Eigen::VectorXd std = InitialStdVector(cfg_, err::kSize15);
   BatchState& s = states_.front();
   const NavState& c = centre.nav;

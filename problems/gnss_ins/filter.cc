@@ -32,8 +32,6 @@
 namespace navtwin::gnss_ins {
 namespace {
 
-constexpr double kTimeEps_s = ins::kSameEpoch_s;
-
 using ins::AidingSource;
 using ins::StateBlock;
 
@@ -194,7 +192,7 @@ class NavigationFilter : public ins::FilterAccess {
       return;
     }
     const std::vector<double>& times = source.times();
-    while (next_[i] < times.size() && times[next_[i]] <= t_s + kTimeEps_s) source.FilterUpdate(next_[i]++, *this);
+    while (next_[i] < times.size() && times[next_[i]] <= t_s + ins::kSameEpoch_s) source.FilterUpdate(next_[i]++, *this);
   }
 
   /// Measurements at epoch t_s, source by source in registration order.
@@ -219,7 +217,7 @@ class NavigationFilter : public ins::FilterAccess {
 
   /// Skips samples before the start (and at it unless the start allows them).
   void SkipMeasurementsBeforeStart(double t0_s) {
-    const double limit = start_.use_measurements_at_start ? t0_s - kTimeEps_s : t0_s + kTimeEps_s;
+    const double limit = start_.use_measurements_at_start ? t0_s - ins::kSameEpoch_s : t0_s + ins::kSameEpoch_s;
     for (std::size_t i = 0; i < sources_.size(); ++i) {
       const std::vector<double>& times = sources_[i]->times();
       while (next_[i] < times.size() && times[next_[i]] < limit) ++next_[i];
@@ -389,7 +387,7 @@ void NavigationFilter::ResetPositionVelocity(const Eigen::Vector3d& dp_ned_m, co
 std::size_t NavigationFilter::FirstImuSample() const {
   const std::vector<ImuSample>& imu = in_.imu;
   const double t0 = start_.state.nav.t_s;
-  const std::size_t k = std::upper_bound(imu.begin(), imu.end(), t0 + kTimeEps_s,
+  const std::size_t k = std::upper_bound(imu.begin(), imu.end(), t0 + ins::kSameEpoch_s,
                                          [](double t, const ImuSample& s) { return t < s.t_s; }) -
                         imu.begin();
   if (k == imu.size()) {
@@ -407,11 +405,11 @@ std::size_t NavigationFilter::FirstImuSample() const {
 /// or the covariance group's end, output.
 void NavigationFilter::ProcessImuSample(const ImuSample& sample, const ImuSample* next, double t0_s) {
   ImuSample rest = sample;
-  if (rest.t_s - rest.dt_s < t0_s - kTimeEps_s) rest = SplitImuSample(rest, t0_s).second;
-  for (long i = NextExactSource(rest.t_s - kTimeEps_s); i >= 0; i = NextExactSource(rest.t_s - kTimeEps_s)) {
+  if (rest.t_s - rest.dt_s < t0_s - ins::kSameEpoch_s) rest = SplitImuSample(rest, t0_s).second;
+  for (long i = NextExactSource(rest.t_s - ins::kSameEpoch_s); i >= 0; i = NextExactSource(rest.t_s - ins::kSameEpoch_s)) {
     const std::size_t si = static_cast<std::size_t>(i);
     const double tg = sources_[si]->times()[next_[si]];
-    if (tg > rest.t_s - rest.dt_s + kTimeEps_s) {
+    if (tg > rest.t_s - rest.dt_s + ins::kSameEpoch_s) {
       const std::pair<ImuSample, ImuSample> parts = SplitImuSample(rest, tg);
       Propagate(parts.first);
       rest = parts.second;
@@ -427,7 +425,7 @@ void NavigationFilter::ProcessImuSample(const ImuSample& sample, const ImuSample
   ProcessEpochMeasurements(t, true);
   if (in_epoch_) {
     EndEpoch(t);
-  } else if (t - last_knot_t_s_ >= cfg_.filter.store_interval_s - kTimeEps_s) {
+  } else if (t - last_knot_t_s_ >= cfg_.filter.store_interval_s - ins::kSameEpoch_s) {
     FlushGroup();
     StoreKnot(t, false);
   } else if (next == nullptr || group_dt_ + next->dt_s > cfg_.filter.covariance_interval_s * (1.0 + 1e-9)) {
@@ -459,7 +457,7 @@ FilterResult NavigationFilter::Run() {
     Progress(k, n_imu, t);
   }
   FlushGroup();
-  if (t > last_knot_t_s_ + kTimeEps_s) StoreKnot(t, false);
+  if (t > last_knot_t_s_ + ins::kSameEpoch_s) StoreKnot(t, false);
   return Result(wall_start);
 }
 

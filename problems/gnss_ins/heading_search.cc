@@ -12,11 +12,10 @@
 #include "core/io/input_error.h"
 #include "core/rotation.h"
 #include "problems/gnss_ins/filter.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
-
-constexpr double kTimeEps_s = 1e-6;
 
 /// The GNSS kinds scored (filter.cc's keys of FilterResult::innovations).
 const char* const kScoredKinds[] = {"gnss_position", "gnss_velocity"};
@@ -36,8 +35,8 @@ template <typename Sample>
 std::vector<Sample> Cut(const std::vector<Sample>& all, double begin_s, double end_s) {
   std::vector<Sample> out;
   for (const Sample& s : all) {
-    if (s.t_s > end_s + kTimeEps_s) break;
-    if (s.t_s > begin_s + kTimeEps_s) out.push_back(s);
+    if (s.t_s > end_s + ins::kSameEpoch_s) break;
+    if (s.t_s > begin_s + ins::kSameEpoch_s) out.push_back(s);
   }
   return out;
 }
@@ -59,7 +58,7 @@ HeadingSearchResult SearchHeading(const Inputs& inputs, const GnssInsConfig& con
   result.window_begin_s = t0;
 
   // The window: the first round(heading_search_s / median interval) GNSS epochs after t0.
-  const auto first = std::upper_bound(inputs.gnss.begin(), inputs.gnss.end(), t0 + kTimeEps_s,
+  const auto first = std::upper_bound(inputs.gnss.begin(), inputs.gnss.end(), t0 + ins::kSameEpoch_s,
                                       [](double t, const GnssSample& g) { return t < g.t_s; });
   const std::size_t available = static_cast<std::size_t>(inputs.gnss.end() - first);
   if (available == 0) {
@@ -83,7 +82,7 @@ HeadingSearchResult SearchHeading(const Inputs& inputs, const GnssInsConfig& con
   // reaching the window's end (the filter processes a GNSS epoch inside a sample's
   // interval); measurements after t0 only, as the static start skips those at t0 (they
   // made the state).
-  const auto imu_end = std::lower_bound(inputs.imu.begin(), inputs.imu.end(), result.window_end_s - kTimeEps_s,
+  const auto imu_end = std::lower_bound(inputs.imu.begin(), inputs.imu.end(), result.window_end_s - ins::kSameEpoch_s,
                                         [](const ImuSample& s, double t) { return s.t_s < t; });
   window.imu.assign(inputs.imu.begin(), imu_end == inputs.imu.end() ? imu_end : imu_end + 1);
   window.gnss = Cut(inputs.gnss, t0, result.window_end_s);

@@ -17,11 +17,10 @@
 #include "problems/ins/error_dynamics.h"
 #include "problems/gnss_ins/heading_search.h"
 #include "problems/ins/sources/mag.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
-
-constexpr double kTimeEps_s = 1e-6;
 
 std::string Seconds(double t_s) {
   std::ostringstream s;
@@ -48,7 +47,7 @@ bool AnyNonZero(const ImuErrors& e) {
 void PositionFromFirstFix(const Inputs& inputs, const GnssInsConfig& config, FilterStart* start) {
   NavState& nav = start->state.nav;
   const auto fix = std::find_if(inputs.gnss.begin(), inputs.gnss.end(), [&](const GnssSample& g) {
-    return g.t_s >= nav.t_s - kTimeEps_s && g.t_s < inputs.imu.back().t_s;
+    return g.t_s >= nav.t_s - ins::kSameEpoch_s && g.t_s < inputs.imu.back().t_s;
   });
   if (fix == inputs.gnss.end()) {
     throw InputError(inputs.paths.gnss, 0, "position",
@@ -83,7 +82,7 @@ FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& conf
   const double end_s = begin_s + init.static_duration_s;
   std::vector<ImuSample> samples;
   for (const ImuSample& s : inputs.imu) {
-    if (s.t_s > end_s + kTimeEps_s) break;
+    if (s.t_s > end_s + ins::kSameEpoch_s) break;
     samples.push_back(CorrectImu(s, init.imu_errors));
   }
   if (inputs.gnss.empty()) {
@@ -104,8 +103,8 @@ FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& conf
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;
     for (const MagSample& m : inputs.mag) {
-      if (m.t_s < begin_s - kTimeEps_s) continue;
-      if (m.t_s > samples.back().t_s + kTimeEps_s) break;
+      if (m.t_s < begin_s - ins::kSameEpoch_s) continue;
+      if (m.t_s > samples.back().t_s + ins::kSameEpoch_s) break;
       sum += CalibrateMag(m.m_b_uT, config.mag);
       ++count;
     }
@@ -198,7 +197,6 @@ Eigen::VectorXd InitialStdVector(const GnssInsConfig& config, int n) {
   }
   return std;
 }
-
 
 FilterStart InitialFilterState(const Inputs& inputs, const GnssInsConfig& config, std::ostream* progress) {
   if (inputs.imu.empty()) throw InputError(inputs.paths.imu, 0, "", "no IMU samples");

@@ -11,13 +11,12 @@
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
 /// Tolerance on time comparisons at the cut points (time tags are often printed with
-/// microsecond resolution).
-constexpr double kTimeTol_s = 1e-6;
 /// An interval longer than this many nominal intervals is a gap.
 constexpr double kGapFactor = 1.5;
 
@@ -62,8 +61,8 @@ std::vector<ImuSample> ReadImu(const std::string& path, const std::string& calib
     RequireFinite(s.dtheta_b_rad.allFinite(), path, "dtheta", s.t_s);
     RequireFinite(s.dv_b_mps.allFinite(), path, "dv", s.t_s);
     s.t_s += inst.imu_time_offset_s;
-    if (s.t_s - s.dt_s < config.start_time_s - kTimeTol_s) continue;
-    if (s.t_s > config.end_time_s + kTimeTol_s) break;
+    if (s.t_s - s.dt_s < config.start_time_s - ins::kSameEpoch_s) continue;
+    if (s.t_s > config.end_time_s + ins::kSameEpoch_s) break;
     s.dtheta_b_rad = R_b_imu * s.dtheta_b_rad;
     s.dv_b_mps = R_b_imu * s.dv_b_mps;
     out.push_back(s);
@@ -143,8 +142,8 @@ std::vector<GnssSample> ReadGnss(const std::string& path, double t_begin, double
       }
     }
     if (g.has_velocity) RequireFinite(g.v_n_mps.allFinite(), path, "velocity", g.t_s);
-    if (g.t_s < t_begin - kTimeTol_s) continue;
-    if (g.t_s > t_end + kTimeTol_s) continue;  // keep reading: later lines are still checked
+    if (g.t_s < t_begin - ins::kSameEpoch_s) continue;
+    if (g.t_s > t_end + ins::kSameEpoch_s) continue;  // keep reading: later lines are still checked
     out.push_back(g);
   }
   return out;
@@ -158,8 +157,8 @@ std::vector<MagSample> ReadMag(const std::string& path, const std::string& calib
   while (reader->Next(&m)) {
     RequireFinite(std::isfinite(m.t_s), path, "time", m.t_s);
     RequireFinite(m.m_b_uT.allFinite(), path, "field", m.t_s);
-    if (m.t_s < t_begin - kTimeTol_s) continue;
-    if (m.t_s > t_end + kTimeTol_s) break;
+    if (m.t_s < t_begin - ins::kSameEpoch_s) continue;
+    if (m.t_s > t_end + ins::kSameEpoch_s) break;
     out.push_back(m);
   }
   return out;
@@ -169,7 +168,7 @@ std::vector<MagSample> ReadMag(const std::string& path, const std::string& calib
 std::vector<OdometerSample> ReadOdometerSpan(const std::string& path, double t_begin, double t_end) {
   std::vector<OdometerSample> out;
   for (const OdometerSample& s : ReadOdometer(path)) {
-    if (s.t_s >= t_begin - kTimeTol_s && s.t_s <= t_end + kTimeTol_s) out.push_back(s);
+    if (s.t_s >= t_begin - ins::kSameEpoch_s && s.t_s <= t_end + ins::kSameEpoch_s) out.push_back(s);
   }
   if (out.empty()) {
     throw InputError(path, 0, "t", "no odometer sample inside the IMU record [" + Num(t_begin) + ", " +
@@ -192,8 +191,8 @@ std::vector<BaroSample> ReadBaro(const std::string& path, double t_begin, double
       }
       b.altitude_m = IsaAltitude_m(b.pressure_pa);
     }
-    if (b.t_s < t_begin - kTimeTol_s) continue;
-    if (b.t_s > t_end + kTimeTol_s) break;
+    if (b.t_s < t_begin - ins::kSameEpoch_s) continue;
+    if (b.t_s > t_end + ins::kSameEpoch_s) break;
     out.push_back(b);
   }
   return out;

@@ -6,12 +6,10 @@
 #include "core/earth.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
-
-/// Times closer than this are the same epoch.
-constexpr double kTimeTol_s = 1e-6;
 
 }  // namespace
 
@@ -76,13 +74,13 @@ struct TrajectoryScorer::Impl {
     if (have_previous && !(s.t_s > previous.t_s)) {
       throw std::invalid_argument("TrajectoryScorer: solution times must increase");
     }
-    while (Peek() && RefTime() <= s.t_s + kTimeTol_s) {
+    while (Peek() && RefTime() <= s.t_s + ins::kSameEpoch_s) {
       const double t = RefTime();
-      if (std::abs(t - s.t_s) <= kTimeTol_s) {
+      if (std::abs(t - s.t_s) <= ins::kSameEpoch_s) {
         NavState at = s;
         at.t_s = t;
         Accumulate(Compare(at));
-      } else if (have_previous && t >= previous.t_s - kTimeTol_s) {
+      } else if (have_previous && t >= previous.t_s - ins::kSameEpoch_s) {
         Accumulate(Compare(InterpolateNav(previous, s, t)));
       }  // else: before the solution starts
       if (gnss_reader && !ref_gnss.has_velocity) report.has_velocity = false;

@@ -115,19 +115,19 @@ class ScaledEuclidean final : public ceres::Manifold {
   std::vector<int> free_;
 };
 
-void Require(bool ok, const std::string& what) {
+void RequireBatchConfig(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("SolveHeadingBatch: " + what);
 }
 
 /// A prior sigma from the configuration (SI): finite and >= 0 (0 holds the coordinate).
 /// `key` is the configuration key the value came from.
 double PriorSigma(double value, const std::string& key) {
-  Require(std::isfinite(value) && value >= 0.0, "config " + key + " must be finite and >= 0");
+  RequireBatchConfig(std::isfinite(value) && value >= 0.0, "config " + key + " must be finite and >= 0");
   return value;
 }
 
 void CheckEpochs(const std::vector<FreeInsEpoch>& epochs) {
-  Require(static_cast<int>(epochs.size()) >= kMinEpochs,
+  RequireBatchConfig(static_cast<int>(epochs.size()) >= kMinEpochs,
           std::to_string(epochs.size()) + " epochs, at least " + std::to_string(kMinEpochs) + " needed");
   double largest_gained_m = 0.0;
   for (std::size_t i = 0; i < epochs.size(); ++i) {
@@ -135,11 +135,11 @@ void CheckEpochs(const std::vector<FreeInsEpoch>& epochs) {
     const std::array<std::pair<const char*, double>, 5> fields = {
         {{"t_s", s.t_s}, {"dn_m", s.dn_m}, {"de_m", s.de_m}, {"err_n_m", s.err_n_m}, {"err_e_m", s.err_e_m}}};
     for (const auto& [name, value] : fields) {
-      Require(std::isfinite(value), "epochs[" + std::to_string(i) + "].sample." + name + " is not finite");
+      RequireBatchConfig(std::isfinite(value), "epochs[" + std::to_string(i) + "].sample." + name + " is not finite");
     }
     largest_gained_m = std::max(largest_gained_m, std::hypot(s.dn_m, s.de_m));
   }
-  Require(largest_gained_m > kMinGainedDisplacement_m,
+  RequireBatchConfig(largest_gained_m > kMinGainedDisplacement_m,
           "the gained displacement never exceeds 100 m (largest " + std::to_string(largest_gained_m) +
               " m): the heading is not observable");
 }
@@ -166,15 +166,15 @@ double RobustWeight(RobustLoss loss, double scale_sigma, double squared_residual
 BatchHeadingSolution SolveHeadingBatch(const std::vector<FreeInsEpoch>& epochs, double gps_sigma_m,
                                        double lat_rad, double schuler_rate_radps, const InflightConfig& config) {
   CheckEpochs(epochs);
-  Require(std::isfinite(gps_sigma_m) && gps_sigma_m > 0.0, "gps_sigma_m must be positive and finite");
-  Require(std::isfinite(lat_rad) && std::abs(lat_rad) <= 0.5 * M_PI, "lat_rad must be finite, |lat| <= pi/2");
-  Require(std::isfinite(schuler_rate_radps) && schuler_rate_radps > 0.0,
+  RequireBatchConfig(std::isfinite(gps_sigma_m) && gps_sigma_m > 0.0, "gps_sigma_m must be positive and finite");
+  RequireBatchConfig(std::isfinite(lat_rad) && std::abs(lat_rad) <= 0.5 * M_PI, "lat_rad must be finite, |lat| <= pi/2");
+  RequireBatchConfig(std::isfinite(schuler_rate_radps) && schuler_rate_radps > 0.0,
           "schuler_rate_radps must be positive and finite");
   const BatchOptions& batch = config.batch;
-  Require(batch.max_iterations >= 1, "config batch.max_iterations must be >= 1");
-  Require(batch.loss == RobustLoss::kNone || (std::isfinite(batch.loss_scale_sigma) && batch.loss_scale_sigma > 0.0),
+  RequireBatchConfig(batch.max_iterations >= 1, "config batch.max_iterations must be >= 1");
+  RequireBatchConfig(batch.loss == RobustLoss::kNone || (std::isfinite(batch.loss_scale_sigma) && batch.loss_scale_sigma > 0.0),
           "config batch.loss_scale_sigma must be positive and finite");
-  Require(std::isfinite(batch.tilt_segment_s) && batch.tilt_segment_s >= 0.0,
+  RequireBatchConfig(std::isfinite(batch.tilt_segment_s) && batch.tilt_segment_s >= 0.0,
           "config batch.tilt_segment_s must be finite and >= 0");
 
   // Prior sigmas (the comment at the top).
@@ -222,7 +222,7 @@ BatchHeadingSolution SolveHeadingBatch(const std::vector<FreeInsEpoch>& epochs, 
   std::vector<double> step_time_s;
   const double step_sigma = arw_rad_sqrt_s * std::sqrt(batch.tilt_segment_s);
   if (batch.tilt_segment_s > 0.0 && step_sigma > 0.0) {
-    Require(last_t_s / batch.tilt_segment_s <= kMaxTiltSteps,
+    RequireBatchConfig(last_t_s / batch.tilt_segment_s <= kMaxTiltSteps,
             "config batch.tilt_segment_s = " + std::to_string(batch.tilt_segment_s) + " s cuts the " +
                 std::to_string(last_t_s) + " s flight into more than " + std::to_string(kMaxTiltSteps) +
                 " level steps (the dense solve grows as their square per fix): use longer segments");

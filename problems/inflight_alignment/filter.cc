@@ -32,7 +32,6 @@ using Gain = Eigen::Matrix<double, kFilterStates, 2>;
 // specific force changes over seconds, so 0.1 s keeps the second-order transition
 // matrix exact to far below the process noise while costing 10x less than per sample.
 constexpr double kBlock_s = 0.1;
-constexpr double kTimeEpsilon_s = 1e-6;
 
 // The filter's states in the 15-state layout of problems/ins/ins_state.h (err::):
 // dp_N, dp_E, dv_N, dv_E, phi_N, phi_E, phi_D, dbg_x, dbg_y, dba_x, dba_y.
@@ -59,24 +58,24 @@ void ResetState(int i, double variance, Matrix11* P) {
   (*P)(i, i) = variance;
 }
 
-void Require(bool ok, const std::string& what) {
+void RequireFilterConfig(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("RunInflightFilter: " + what);
 }
 
 void CheckConfig(const InflightConfig& c) {
   auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
-  Require(non_negative(c.sensors.gyro_bias_radps), "sensors.gyro_bias_deg_h must be >= 0");
-  Require(non_negative(c.sensors.gyro_arw_rad_per_sqrt_s), "sensors.gyro_arw_deg_sqrt_h must be >= 0");
-  Require(non_negative(c.sensors.accel_bias_mps2), "sensors.accel_bias_ug must be >= 0");
-  Require(non_negative(c.sensors.accel_vrw_mps_per_sqrt_s), "sensors.accel_vrw_m_s_sqrt_h must be >= 0");
-  Require(positive(c.initial.position_m), "initial.position_m must be > 0");
-  Require(positive(c.initial.velocity_mps) || c.initial.velocity_mps == 0.0, "initial.velocity_mps must be >= 0");
-  Require(positive(c.initial.level_rad), "initial.level_arcmin must be > 0");
-  Require(positive(c.initial.heading_rad), "initial.heading_arcmin must be > 0");
-  Require(positive(c.baro.time_constant_s), "baro.time_constant_s must be > 0");
-  Require(positive(c.distance.threshold_m), "distance.threshold_km must be > 0");
-  Require(non_negative(c.distance.recompute_every_m), "distance.recompute_every_km must be >= 0");
+  RequireFilterConfig(non_negative(c.sensors.gyro_bias_radps), "sensors.gyro_bias_deg_h must be >= 0");
+  RequireFilterConfig(non_negative(c.sensors.gyro_arw_rad_per_sqrt_s), "sensors.gyro_arw_deg_sqrt_h must be >= 0");
+  RequireFilterConfig(non_negative(c.sensors.accel_bias_mps2), "sensors.accel_bias_ug must be >= 0");
+  RequireFilterConfig(non_negative(c.sensors.accel_vrw_mps_per_sqrt_s), "sensors.accel_vrw_m_s_sqrt_h must be >= 0");
+  RequireFilterConfig(positive(c.initial.position_m), "initial.position_m must be > 0");
+  RequireFilterConfig(positive(c.initial.velocity_mps) || c.initial.velocity_mps == 0.0, "initial.velocity_mps must be >= 0");
+  RequireFilterConfig(positive(c.initial.level_rad), "initial.level_arcmin must be > 0");
+  RequireFilterConfig(positive(c.initial.heading_rad), "initial.heading_arcmin must be > 0");
+  RequireFilterConfig(positive(c.baro.time_constant_s), "baro.time_constant_s must be > 0");
+  RequireFilterConfig(positive(c.distance.threshold_m), "distance.threshold_km must be > 0");
+  RequireFilterConfig(non_negative(c.distance.recompute_every_m), "distance.recompute_every_km must be >= 0");
 }
 
 // The separation options of the distance method (filter.h, docs): Schuler rate at the
@@ -224,7 +223,7 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
     block_dtheta_rad += corrected.dtheta_b_rad;
     block_dv_mps += corrected.dv_b_mps;
     block_dt_s += corrected.dt_s;
-    if (block_dt_s >= kBlock_s - kTimeEpsilon_s) propagate();
+    if (block_dt_s >= kBlock_s - ins::kSameEpoch_s) propagate();
     const double speed_mps = nav.v_n_mps.head<2>().norm();
     path_length_m += 0.5 * (last_speed_mps + speed_mps) * (nav.t_s - last_t_s);
     last_speed_mps = speed_mps;
@@ -250,15 +249,15 @@ FilterRun RunInflightFilter(const InflightInputs& inputs, const InflightConfig& 
   };
 
   std::size_t next_imu = 0;
-  while (next_imu < inputs.imu.size() && inputs.imu[next_imu].t_s <= t0_s + kTimeEpsilon_s) ++next_imu;
+  while (next_imu < inputs.imu.size() && inputs.imu[next_imu].t_s <= t0_s + ins::kSameEpoch_s) ++next_imu;
   const double t_end_s = inputs.imu.back().t_s;
 
   for (const GnssSample& fix : inputs.gnss) {
-    if (fix.t_s < t0_s - kTimeEpsilon_s) continue;  // before the alignment started
-    if (fix.t_s > t_end_s + kTimeEpsilon_s) break;  // after the IMU data
+    if (fix.t_s < t0_s - ins::kSameEpoch_s) continue;  // before the alignment started
+    if (fix.t_s > t_end_s + ins::kSameEpoch_s) break;  // after the IMU data
     // Step the INS to the first IMU epoch at or after the fix (at most one IMU interval
     // late; the INS position is moved back to the fix time below).
-    while (strapdown.state().t_s < fix.t_s - kTimeEpsilon_s && next_imu < inputs.imu.size()) {
+    while (strapdown.state().t_s < fix.t_s - ins::kSameEpoch_s && next_imu < inputs.imu.size()) {
       step(inputs.imu[next_imu++]);
     }
     propagate();  // P to the INS epoch (the partial block)

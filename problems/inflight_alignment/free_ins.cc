@@ -9,20 +9,17 @@
 
 #include "core/earth.h"
 #include "core/rotation.h"
+#include "problems/inflight_alignment/gps_smoother.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin::inflight {
 namespace {
 
-// Third differences z_k - 3 z_k-1 + 3 z_k-2 - z_k-3 of white noise have variance
-// (1 + 9 + 9 + 1) sigma^2 = 20 sigma^2.
-const double kThirdDiffGain = std::sqrt(20.0);
 // median |d| = 0.6745 sigma_d for a normal d: 1.4826 = 1 / 0.6745 turns it into sigma_d.
 constexpr double kMadToSigma = 1.4826;
 // Consecutive fix intervals within this fraction of each other count as equally spaced
 // (a third difference cancels constant-acceleration motion only on an even grid).
-constexpr double kSpacingTolerance = 1e-3;
-// Times closer than this (s) are the same epoch (file times carry rounding).
-constexpr double kTimeEpsilon_s = 1e-6;
+constexpr double kEvenSpacingTolerance = 1e-3;
 
 // A position moved along the velocity v_n_mps by dt_s (NED, small dt: first order in the
 // radii, which is exact to (v dt)^2 / R, 1e-9 m for 10 ms at 238 m/s).
@@ -138,15 +135,15 @@ std::vector<FreeInsEpoch> RunFreeIns(const InflightInputs& inputs, const Infligh
   FreeInsTrack track(inputs.initial, config.baro);
   // IMU samples after the initial state (their interval ends after initial.t_s).
   std::size_t next_imu = 0;
-  while (next_imu < inputs.imu.size() && inputs.imu[next_imu].t_s <= t0_s + kTimeEpsilon_s) ++next_imu;
+  while (next_imu < inputs.imu.size() && inputs.imu[next_imu].t_s <= t0_s + ins::kSameEpoch_s) ++next_imu;
   const double t_end_s = inputs.imu.back().t_s;
 
   std::vector<FreeInsEpoch> epochs;
   for (const GnssSample& fix : inputs.gnss) {
-    if (fix.t_s < t0_s - kTimeEpsilon_s) continue;   // before the alignment started
-    if (fix.t_s > t_end_s + kTimeEpsilon_s) break;   // after the IMU data
+    if (fix.t_s < t0_s - ins::kSameEpoch_s) continue;   // before the alignment started
+    if (fix.t_s > t_end_s + ins::kSameEpoch_s) break;   // after the IMU data
     // Step to the first IMU epoch at or after the fix.
-    while (track.state().t_s < fix.t_s - kTimeEpsilon_s && next_imu < inputs.imu.size()) {
+    while (track.state().t_s < fix.t_s - ins::kSameEpoch_s && next_imu < inputs.imu.size()) {
       const ImuSample& imu = inputs.imu[next_imu++];
       track.Update(imu, BaroAltitudeAt(inputs.baro, imu.t_s));
     }
@@ -177,8 +174,8 @@ double EstimateGpsSigma(const std::vector<GnssSample>& gnss) {
     const double dt1 = gnss[k].t_s - gnss[k - 1].t_s;
     const double dt2 = gnss[k - 1].t_s - gnss[k - 2].t_s;
     const double dt3 = gnss[k - 2].t_s - gnss[k - 3].t_s;
-    if (!(dt1 > 0.0) || std::abs(dt2 - dt1) > kSpacingTolerance * dt1 ||
-        std::abs(dt3 - dt1) > kSpacingTolerance * dt1) {
+    if (!(dt1 > 0.0) || std::abs(dt2 - dt1) > kEvenSpacingTolerance * dt1 ||
+        std::abs(dt3 - dt1) > kEvenSpacingTolerance * dt1) {
       continue;  // a gap: the difference would not cancel the motion
     }
     const Eigen::Vector2d d = ne[k] - 3.0 * ne[k - 1] + 3.0 * ne[k - 2] - ne[k - 3];
@@ -190,8 +187,8 @@ double EstimateGpsSigma(const std::vector<GnssSample>& gnss) {
   }
   // A robust scale: the median of |d| is blind to the few differences an outlier spoils
   // (each outlier enters four of them).
-  const double sigma_n = kMadToSigma * MedianAbs(&dn) / kThirdDiffGain;
-  const double sigma_e = kMadToSigma * MedianAbs(&de) / kThirdDiffGain;
+  const double sigma_n = kMadToSigma * MedianAbs(&dn) / kThirdDifferenceGain;
+  const double sigma_e = kMadToSigma * MedianAbs(&de) / kThirdDifferenceGain;
   return std::max(sigma_n, sigma_e);
 }
 

@@ -17,11 +17,8 @@ namespace {
 
 constexpr int kQuiet = 0;
 constexpr int kManeuver = 1;
-// Third differences z_k - 3 z_k-1 + 3 z_k-2 - z_k-3 of white noise have variance
-// (1 + 9 + 9 + 1) sigma^2.
-const double kThirdDiffGain = std::sqrt(20.0);
 // Consecutive intervals within this fraction of each other count as equally spaced.
-constexpr double kSpacingTolerance = 0.01;
+constexpr double kEvenIntervalTolerance = 0.01;
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
@@ -248,7 +245,7 @@ void GpsSmoother::PushNoiseSample(double t_s, const Eigen::Vector3d& z_ned_m) {
   const double d1 = recent_[1].first - recent_[0].first;
   const double d2 = recent_[2].first - recent_[1].first;
   const double d3 = recent_[3].first - recent_[2].first;
-  if (std::max(std::abs(d2 - d1), std::abs(d3 - d1)) > kSpacingTolerance * d1) return;
+  if (std::max(std::abs(d2 - d1), std::abs(d3 - d1)) > kEvenIntervalTolerance * d1) return;
   third_diff_sq_m2_.push_back(
       (recent_[3].second - 3.0 * recent_[2].second + 3.0 * recent_[1].second - recent_[0].second).cwiseAbs2());
   if (third_diff_sq_m2_.size() > static_cast<std::size_t>(options_.noise_window_fixes)) {
@@ -265,7 +262,7 @@ Eigen::Vector3d GpsSmoother::MeasurementSigma() const {
   mean_sq /= static_cast<double>(third_diff_sq_m2_.size());
   Eigen::Vector3d sigma;
   for (int a = 0; a < 3; ++a) {
-    sigma(a) = std::clamp(std::sqrt(mean_sq(a)) / kThirdDiffGain, options_.min_position_sigma_m,
+    sigma(a) = std::clamp(std::sqrt(mean_sq(a)) / kThirdDifferenceGain, options_.min_position_sigma_m,
                           options_.max_position_sigma_m);
   }
   return sigma;

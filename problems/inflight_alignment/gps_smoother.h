@@ -42,6 +42,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <deque>
 #include <utility>
@@ -52,6 +53,10 @@
 #include "core/types.h"
 
 namespace navtwin::inflight {
+
+/// Third differences z_k - 3 z_k-1 + 3 z_k-2 - z_k-3 of white noise of standard deviation
+/// sigma have standard deviation sqrt(1 + 9 + 9 + 1) sigma: sigma = sd(third difference) / this.
+inline const double kThirdDifferenceGain = std::sqrt(20.0);
 
 struct GpsSmootherOptions {
   /// Quiet mode (straight flight): white acceleration noise per axis, as the square root

@@ -155,7 +155,5 @@ inline const StillnessConfig* StillnessRule(const AidingSources& sources) {
   return nullptr;
 }
 
-/// Times samples are the same epoch within (IMU rates stay far below 1 MHz).
-constexpr double kSameEpoch_s = 1e-6;
 
 }  // namespace navtwin::ins

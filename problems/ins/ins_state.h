@@ -24,6 +24,10 @@
 
 namespace navtwin::ins {
 
+/// Time tags within this are the same epoch (IMU rates stay far below 1 MHz; files written
+/// at the same epochs agree to the microsecond).
+constexpr double kSameEpoch_s = 1e-6;
+
 /// Indices of the error-state blocks.
 namespace err {
 constexpr int kPos = 0;

@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "core/io/input_error.h"
+#include "problems/ins/ins_state.h"
 
 namespace navtwin {
 namespace {
@@ -16,11 +17,9 @@ class TruthComparer {
   explicit TruthComparer(NavReader* truth) : truth_(truth) { have_ = truth_ && truth_->Next(&next_); }
 
   void Advance(const NavState& prev, const NavState& cur, NavErrorStats* stats) {
-    // Time tags agree to the microsecond in files written at the same epochs.
-    constexpr double kSameEpoch_s = 1e-6;
-    while (have_ && next_.t_s <= cur.t_s + kSameEpoch_s) {
-      if (next_.t_s >= prev.t_s - kSameEpoch_s) {
-        const NavState at = std::abs(next_.t_s - cur.t_s) <= kSameEpoch_s
+    while (have_ && next_.t_s <= cur.t_s + ins::kSameEpoch_s) {
+      if (next_.t_s >= prev.t_s - ins::kSameEpoch_s) {
+        const NavState at = std::abs(next_.t_s - cur.t_s) <= ins::kSameEpoch_s
                                 ? cur
                                 : InterpolateNav(prev, cur, next_.t_s);
         stats->Add(CompareNav(at, next_));
@@ -38,10 +37,9 @@ class TruthComparer {
 }  // namespace
 
 NavState InitialStateFromNav(NavReader& nav, std::optional<double> start_s) {
-  constexpr double kSameEpoch_s = 1e-6;
   NavState s;
   while (nav.Next(&s)) {
-    if (!start_s || s.t_s >= *start_s - kSameEpoch_s) return s;
+    if (!start_s || s.t_s >= *start_s - ins::kSameEpoch_s) return s;
   }
   throw InputError(nav.path(), 0, "sow",
                    start_s ? "no record at or after the start time " + std::to_string(*start_s) + " s"

@@ -62,7 +62,7 @@ double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-void CheckConfig(const TransferConfig& c) {
+void CheckBatchConfig(const TransferConfig& c) {
   const auto positive = [](double x, const char* name) {
     if (!(x > 0.0) || !std::isfinite(x)) {
       throw std::invalid_argument(std::string("SolveTransferBatch: config ") + name + " must be positive and finite");
@@ -313,7 +313,7 @@ void TransferBatch::Covariance(TransferBatchSolution* out) {
 
 TransferBatchSolution TransferBatch::Run() {
   const auto wall_start = std::chrono::steady_clock::now();
-  CheckConfig(cfg_);
+  CheckBatchConfig(cfg_);
   if (start_.epochs.empty()) throw std::invalid_argument("SolveTransferBatch: the start run has no epoch");
   const TransferEpoch& last = start_.epochs.back();
   if (!last.misalignment.coeffs().allFinite() || !std::isfinite(last.delay_s)) {

@@ -97,7 +97,7 @@ void Require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("RunTransferFilter: configuration: " + what);
 }
 
-void CheckConfig(const TransferConfig& c) {
+void CheckFilterConfig(const TransferConfig& c) {
   auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
   auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
   Require(non_negative(c.gyro_bias_radps), "gyro_bias_radps must be >= 0");
@@ -174,7 +174,7 @@ class TransferFilter {
 
  private:
   static Eigen::MatrixXd InitialCovariance(const TransferConfig& c) {
-    CheckConfig(c);
+    CheckFilterConfig(c);
     Vector10 sd;
     sd.segment<3>(kVel).setConstant(c.initial_velocity_mps);
     sd.segment<3>(kAtt).setConstant(c.initial_attitude_rad);
