@@ -16,10 +16,11 @@
 #include <ceres/crs_matrix.h>
 #include <ceres/iteration_callback.h>
 #include <ceres/solver.h>
-#include <Eigen/Eigenvalues>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+
+#include "core/linalg.h"
 
 namespace navtwin {
 namespace {
@@ -171,8 +172,8 @@ void DiagnoseNullSpace(const ceres::Problem& problem, const std::vector<const do
       }
     }
   }
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jtj);  // ascending eigenvalues
-  const Eigen::VectorXd& lambda = eigen.eigenvalues();
+  const SymmetricEigen eigen = SymmetricEigenDecomposition(jtj);  // ascending eigenvalues
+  const Eigen::VectorXd& lambda = eigen.values;
   const double lambda_max = lambda.size() > 0 ? lambda.maxCoeff() : 0.0;
   int null_rank = 0;
   while (null_rank < lambda.size() && lambda(null_rank) <= options.min_reciprocal_condition_number * lambda_max) {
@@ -191,7 +192,7 @@ void DiagnoseNullSpace(const ceres::Problem& problem, const std::vector<const do
     const int size = problem.ParameterBlockTangentSize(blocks[i]);
     const int column = jacobian.Column(blocks[i]);
     if (column >= 0) {  // a constant block has no null-space component
-      result->null_space.middleRows(row, size) = eigen.eigenvectors().block(column, 0, size, null_rank);
+      result->null_space.middleRows(row, size) = eigen.vectors.block(column, 0, size, null_rank);
       if (null_rank > 0 && result->null_space.middleRows(row, size).norm() > kParticipation) {
         result->unobservable_blocks.push_back(static_cast<int>(i));
         names << (result->unobservable_blocks.size() > 1 ? ", " : "") << i;

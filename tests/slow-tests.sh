@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates tests/slow_tests.txt from the last ctest run's measured costs in a build
 # folder: the tests that took at least THRESHOLD_S seconds (default 0.4) are labelled
-# `slow`, every other test `quick` (tests/labels.cmake).
+# `slow`, every other test `quick` (tests/labels.cmake.in).
 #   bash tests/slow-tests.sh [BUILD_DIR] [THRESHOLD_S]
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -19,6 +19,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "core/linalg.h"
 #include "core/rotation.h"
 #include "problems/calibration/mag_ellipsoid.h"
 
@@ -305,13 +306,12 @@ MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const Ellipso
     rhs += phi;
   }
   normal = normal.selfadjointView<Eigen::Lower>();
-  const Eigen::SelfAdjointEigenSolver<Matrix9d> eig_n(normal);
-  if (!(eig_n.eigenvalues()(0) > 1e-12 * eig_n.eigenvalues()(8))) {
+  const SymmetricEigen eig_n = SymmetricEigenDecomposition(normal);
+  if (!(eig_n.values(0) > 1e-12 * eig_n.values(8))) {
     throw std::runtime_error("FitEllipsoid: the samples do not determine an ellipsoid (normal equations singular): "
                              "rotate the sensor through more attitudes");
   }
-  const Vector9d theta = eig_n.eigenvectors() *
-                         (eig_n.eigenvalues().cwiseInverse().asDiagonal() * (eig_n.eigenvectors().transpose() * rhs));
+  const Vector9d theta = eig_n.vectors * (eig_n.values.cwiseInverse().asDiagonal() * (eig_n.vectors.transpose() * rhs));
   MagCalibration c;
   std::string why;
   if (!EllipsoidFromQuadric(theta, mean, scale_uT, options.field_uT, &c, &why)) {

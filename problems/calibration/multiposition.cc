@@ -15,11 +15,11 @@
 
 #include <ceres/ceres.h>
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "core/earth.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
+#include "core/linalg.h"
 #include "core/rotation.h"
 #include "problems/calibration/imu_calibration_residuals.h"
 
@@ -307,10 +307,10 @@ Observability AnalyseObservability(const Eigen::MatrixXd& J, const std::vector<b
     if (a.empty()) break;
     Eigen::MatrixXd Jn(J.rows(), static_cast<Eigen::Index>(a.size()));
     for (std::size_t k = 0; k < a.size(); ++k) Jn.col(k) = J.col(a[k]) / norms(a[k]);
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Jn.transpose() * Jn);
-    const double largest = eig.eigenvalues().maxCoeff();
-    if (!(eig.eigenvalues()(0) < kNullEigenvalueRatio * largest)) break;
-    const Eigen::VectorXd v = eig.eigenvectors().col(0);
+    const SymmetricEigen eig = SymmetricEigenDecomposition(Jn.transpose() * Jn);
+    const double largest = eig.values.maxCoeff();
+    if (!(eig.values(0) < kNullEigenvalueRatio * largest)) break;
+    const Eigen::VectorXd v = eig.vectors.col(0);
     const double vmax = v.cwiseAbs().maxCoeff();
     // Hold a scale factor, misalignment or g-sensitivity before a bias.
     int pick = -1;

@@ -18,13 +18,13 @@
 
 #include <ceres/ceres.h>
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "core/earth.h"
 #include "core/io/csv_series.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/io/text_reader.h"
+#include "core/linalg.h"
 #include "core/rotation.h"
 #include "core/sim/calibration_rig.h"
 #include "core/config/yaml_config.h"
@@ -184,7 +184,7 @@ SwingStart StartOfSwing(const AngleRecord& a) {
     A.row(i) << 1.0, dt, dt * dt;
     y(i) = a.theta_rad[i];
   }
-  const Eigen::Vector3d q = A.colPivHouseholderQr().solve(y);
+  const Eigen::Vector3d q = LeastSquaresColPivQr(A, y);
   s.p = {c1, w0 * w0, q(0), q(1)};
   return s;
 }
@@ -385,9 +385,9 @@ std::vector<int> ObservableColumns(const AxisProblem& axis, const Normal& total,
   while (keep.size() > 1) {
     const Eigen::MatrixXd S = Sub(total.N, keep);
     const Eigen::VectorXd d = S.diagonal().cwiseSqrt().cwiseInverse();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(d.asDiagonal() * S * d.asDiagonal());
-    if (eig.eigenvalues()(0) >= kCollinear * eig.eigenvalues().maxCoeff()) break;
-    const Eigen::VectorXd v = eig.eigenvectors().col(0);
+    const SymmetricEigen eig = SymmetricEigenDecomposition(d.asDiagonal() * S * d.asDiagonal());
+    if (eig.values(0) >= kCollinear * eig.values.maxCoeff()) break;
+    const Eigen::VectorXd v = eig.vectors.col(0);
     Eigen::Index worst = 0;
     v.cwiseAbs().maxCoeff(&worst);
     std::string with;
@@ -420,8 +420,8 @@ Eigen::VectorXd SolveAll(const std::vector<PreparedRun>& runs, const std::vector
 Eigen::Matrix4d CovarianceRoot(const Eigen::Matrix4d& P) {
   const Eigen::LLT<Eigen::Matrix4d> llt(P);
   if (llt.info() == Eigen::Success) return llt.matrixL();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(P);
-  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  const SymmetricEigen eig = SymmetricEigenDecomposition(P);
+  return eig.vectors * eig.values.cwiseMax(0.0).cwiseSqrt().asDiagonal();
 }
 
 SwingFit Perturbed(const SwingFit& fit, const Eigen::Vector4d& d) {

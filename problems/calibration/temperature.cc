@@ -13,12 +13,12 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
 #include "core/io/csv_series.h"
 #include "core/io/input_error.h"
 #include "core/io/text_reader.h"
+#include "core/linalg.h"
 #include "core/sim/calibration_rig.h"
 #include "core/config/yaml_config.h"
 
@@ -442,9 +442,9 @@ void SolveAxis(AxisFit* fit, double scale, const std::string& what) {
   }
   // Directions the positions and temperatures cannot separate.
   const Eigen::MatrixXd A_n = A_w * norms.cwiseInverse().asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A_n.transpose() * A_n);
-  if (eig.eigenvalues()(0) < kWarmUpNullEigenvalueRatio * eig.eigenvalues().maxCoeff()) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(0);
+  const SymmetricEigen eig = SymmetricEigenDecomposition(A_n.transpose() * A_n);
+  if (eig.values(0) < kWarmUpNullEigenvalueRatio * eig.values.maxCoeff()) {
+    const Eigen::VectorXd v = eig.vectors.col(0);
     const double vmax = v.cwiseAbs().maxCoeff();
     std::string names;
     for (int j = 0; j < p; ++j) {
