@@ -6,7 +6,6 @@
 #pragma once
 
 #include <initializer_list>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,9 +13,6 @@
 #include <yaml-cpp/yaml.h>
 
 namespace navtwin {
-
-/// The `hi` of ConfigNode::Double for a value bounded only below.
-inline constexpr double kNoUpperBound = std::numeric_limits<double>::infinity();
 
 /// A YAML mapping with the file it came from and its key path, for messages.
 class ConfigNode {
@@ -34,7 +30,7 @@ class ConfigNode {
   std::vector<ConfigNode> Elements(const std::string& key) const;
 
   double Double(const std::string& key, double fallback) const;
-  /// Like Double, and throws unless lo <= value <= hi (hi = kNoUpperBound: none).
+  /// Like Double, and throws unless lo <= value <= hi.
   double Double(const std::string& key, double fallback, double lo, double hi) const;
   /// A standard deviation or another scale: finite and > 0 ("must be > 0, got X").
   double Positive(const std::string& key, double fallback) const;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -257,11 +256,11 @@ GnssSimConfig ParseGnssSimConfig(const ConfigNode& node) {
   c.time_offset_s = node.Double("time_offset_s", 0.0, -kSecondsPerDay, kSecondsPerDay);
   for (const ConfigNode& e : node.Elements("outages")) c.outages_s.push_back(Interval(e));
   c.outlier_probability = node.Double("outlier_probability", 0.0, 0.0, 1.0);
-  c.outlier_size_m = node.Double("outlier_size_m", 0.0, 0.0, kNoUpperBound);
+  c.outlier_size_m = node.NonNegative("outlier_size_m", 0.0);
   if (c.outlier_probability > 0.0 && !(c.outlier_size_m > 0.0)) {
     node.Fail("outlier_size_m", "must be > 0 when outlier_probability > 0");
   }
-  c.start_s = node.Double("start_s", 0.0, 0.0, kNoUpperBound);
+  c.start_s = node.NonNegative("start_s", 0.0);
   return c;
 }
 
@@ -397,15 +396,15 @@ MagSimConfig ParseMagSimConfig(const ConfigNode& node) {
     if (!(*c.intensity_uT > 0.0)) node.Fail("intensity_uT", "must be > 0");
   }
   RequireNotBoth(node, "hard_iron_uT", "hard_iron_fixed_uT");
-  c.hard_iron_sigma_uT = node.Double("hard_iron_uT", 0.0, 0.0, kNoUpperBound);
+  c.hard_iron_sigma_uT = node.NonNegative("hard_iron_uT", 0.0);
   if (node.Has("hard_iron_fixed_uT")) {
     c.hard_iron_fixed_uT = node.Vector("hard_iron_fixed_uT", Eigen::Vector3d::Zero());
   }
   RequireNotBoth(node, "soft_iron", "soft_iron_fixed");
-  c.soft_iron_sigma = node.Double("soft_iron", 0.0, 0.0, kNoUpperBound);
+  c.soft_iron_sigma = node.NonNegative("soft_iron", 0.0);
   if (node.Has("soft_iron_fixed")) c.soft_iron_fixed = Matrix3(node, "soft_iron_fixed");
   c.soft_iron_symmetric = node.Bool("soft_iron_symmetric", false);
-  c.noise_uT = node.Double("noise_uT", 0.0, 0.0, kNoUpperBound);
+  c.noise_uT = node.NonNegative("noise_uT", 0.0);
   c.two_axis = node.Bool("two_axis", false);
   return c;
 }
@@ -488,9 +487,9 @@ BaroSimConfig ParseBaroSimConfig(const ConfigNode& node) {
   BaroSimConfig c;
   c.rate_hz = Rate(node, c.rate_hz, 1000.0);
   RequireNotBoth(node, "bias_m", "bias_fixed_m");
-  c.bias_sigma_m = node.Double("bias_m", 0.0, 0.0, kNoUpperBound);
+  c.bias_sigma_m = node.NonNegative("bias_m", 0.0);
   if (node.Has("bias_fixed_m")) c.bias_fixed_m = node.Double("bias_fixed_m", 0.0);
-  c.noise_m = node.Double("noise_m", 0.0, 0.0, kNoUpperBound);
+  c.noise_m = node.NonNegative("noise_m", 0.0);
   c.pressure = node.Bool("pressure", true);
   return c;
 }
@@ -582,7 +581,7 @@ OdometerSimConfig ParseOdometerSimConfig(const ConfigNode& node) {
   if (node.Has("scale_factor_fixed_ppm")) {
     c.scale_factor_fixed = node.Double("scale_factor_fixed_ppm", 0.0, -1e5, 1e5) * 1e-6;
   }
-  c.noise_mps = node.Double("noise_mps", 0.0, 0.0, kNoUpperBound);
+  c.noise_mps = node.NonNegative("noise_mps", 0.0);
   c.lever_arm_b_m = node.Vector("lever_arm_b_m", Eigen::Vector3d::Zero());
   return c;
 }
@@ -630,14 +629,14 @@ MasterSimConfig ParseMasterSimConfig(const ConfigNode& node) {
   c.rate_hz = Rate(node, c.rate_hz, 1000.0);
   c.transfer_delay_s = node.Double("transfer_delay_s", 0.0, 0.0, 10.0);
   RequireNotBoth(node, "attitude_error_sigma_mrad", "attitude_error_fixed_mrad");
-  c.attitude_error_sigma_rad = node.Double("attitude_error_sigma_mrad", 0.0, 0.0, kNoUpperBound) * kMrad_rad;
+  c.attitude_error_sigma_rad = node.NonNegative("attitude_error_sigma_mrad", 0.0) * kMrad_rad;
   if (node.Has("attitude_error_fixed_mrad")) {
     c.attitude_error_fixed_rad =
         node.Vector("attitude_error_fixed_mrad", Eigen::Vector3d::Zero()) * kMrad_rad;
   }
   c.attitude_random_walk_rad_sqrt_s =
-      node.Double("attitude_random_walk_mrad_sqrt_h", 0.0, 0.0, kNoUpperBound) * kMrad_rad / kSqrtHour_sqrts;
-  c.velocity_noise_mps = node.Double("velocity_noise_mps", 0.0, 0.0, kNoUpperBound);
+      node.NonNegative("attitude_random_walk_mrad_sqrt_h", 0.0) * kMrad_rad / kSqrtHour_sqrts;
+  c.velocity_noise_mps = node.NonNegative("velocity_noise_mps", 0.0);
   return c;
 }
 

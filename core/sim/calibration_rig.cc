@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -71,7 +70,7 @@ Eigen::Vector3d DegVector(const ConfigNode& node, const std::string& key) {
 TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
   node.RequireKeys({"euler_deg", "rotate", "rate_deg_s", "duration_s", "ramp_s", "dwell_s"});
   TableStep s;
-  s.dwell_s = node.Double("dwell_s", default_dwell_s, 0.0, kNoUpperBound);
+  s.dwell_s = node.NonNegative("dwell_s", default_dwell_s);
   if (node.Has("euler_deg") == node.Has("rotate")) {
     node.Fail("", "give either euler_deg (a position) or rotate (a rate-table rotation)");
   }
@@ -93,8 +92,8 @@ TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
   if (!node.Has("rate_deg_s")) node.Fail("rate_deg_s", "required for a rotation");
   s.rate_radps =
       node.Double("rate_deg_s", 0.0, -kMaxTableRate_deg_s, kMaxTableRate_deg_s) * kDegToRad;
-  s.duration_s = node.Double("duration_s", 0.0, 0.0, kNoUpperBound);
-  s.ramp_s = node.Double("ramp_s", s.ramp_s, 0.0, kNoUpperBound);
+  s.duration_s = node.NonNegative("duration_s", 0.0);
+  s.ramp_s = node.NonNegative("ramp_s", s.ramp_s);
   if (!(s.ramp_s > 0.0)) node.Fail("ramp_s", "must be > 0 (the angular rate must be continuous)");
   return s;
 }
@@ -102,9 +101,9 @@ TableStep ParseTableStep(const ConfigNode& node, double default_dwell_s) {
 MultiPositionConfig ParseMultiPosition(const ConfigNode& node) {
   node.RequireKeys({"kind", "rotation_s", "dwell_s", "steps"});
   MultiPositionConfig c;
-  c.rotation_s = node.Double("rotation_s", c.rotation_s, 0.0, kNoUpperBound);
+  c.rotation_s = node.NonNegative("rotation_s", c.rotation_s);
   if (!(c.rotation_s > 0.0)) node.Fail("rotation_s", "must be > 0");
-  const double dwell_s = node.Double("dwell_s", 10.0, 0.0, kNoUpperBound);
+  const double dwell_s = node.NonNegative("dwell_s", 10.0);
   for (const ConfigNode& step : node.Elements("steps")) {
     c.steps.push_back(ParseTableStep(step, dwell_s));
   }
@@ -117,9 +116,9 @@ PendulumConfig ParsePendulum(const ConfigNode& node) {
                     "initial_rate_deg_s", "mounting", "mounting_deg", "angle_noise_deg",
                     "angle_quantum_deg"});
   PendulumConfig c;
-  c.length_m = node.Double("length_m", c.length_m, 0.0, kNoUpperBound);
+  c.length_m = node.NonNegative("length_m", c.length_m);
   if (!(c.length_m > 0.0)) node.Fail("length_m", "must be > 0");
-  c.damping_per_s = node.Double("damping_per_s", 0.0, 0.0, kNoUpperBound);
+  c.damping_per_s = node.NonNegative("damping_per_s", 0.0);
   if (node.Has("c2_per_s2")) {
     c.c2_per_s2 = node.Double("c2_per_s2", 0.0);
     if (!(*c.c2_per_s2 > 0.0)) node.Fail("c2_per_s2", "must be > 0");

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "core/rotation.h"
@@ -68,7 +67,7 @@ AxisConstant ParseAxisConstant(const ConfigNode& node, const std::string& sigma_
                                const std::string& fixed_key, double si) {
   RequireNotBoth(node, sigma_key, fixed_key);
   AxisConstant c;
-  c.sigma = node.Double(sigma_key, 0.0, 0.0, kNoUpperBound) * si;
+  c.sigma = node.NonNegative(sigma_key, 0.0) * si;
   if (node.Has(fixed_key)) c.fixed = node.Vector(fixed_key, Eigen::Vector3d::Zero()) * si;
   return c;
 }
@@ -77,7 +76,7 @@ MatrixConstant ParseMatrixConstant(const ConfigNode& node, const std::string& si
                                    const std::string& fixed_key, double si) {
   RequireNotBoth(node, sigma_key, fixed_key);
   MatrixConstant c;
-  c.sigma = node.Double(sigma_key, 0.0, 0.0, kNoUpperBound) * si;
+  c.sigma = node.NonNegative(sigma_key, 0.0) * si;
   if (node.Has(fixed_key)) c.fixed = ParseMatrix3(node, fixed_key) * si;
   return c;
 }
@@ -104,19 +103,19 @@ TriadErrorConfig ParseTriad(const ConfigNode& node, const TriadUnits& u) {
                     u.quantum_key.c_str(), "temperature"});
   TriadErrorConfig c;
   c.bias = ParseAxisConstant(node, bias, bias_fixed, u.rate_si);
-  c.bias_instability = node.Double(instability, 0.0, 0.0, kNoUpperBound) * u.rate_si;
-  c.correlation_time_s = node.Double("correlation_time_s", 0.0, 0.0, kNoUpperBound);
+  c.bias_instability = node.NonNegative(instability, 0.0) * u.rate_si;
+  c.correlation_time_s = node.NonNegative("correlation_time_s", 0.0);
   if (c.bias_instability > 0.0 && !(c.correlation_time_s > 0.0)) {
     node.Fail("correlation_time_s", "required (> 0) with " + instability);
   }
-  c.random_walk = node.Double(u.random_walk_key, 0.0, 0.0, kNoUpperBound) * u.random_walk_si;
-  c.white_noise = node.Double(u.white_key, 0.0, 0.0, kNoUpperBound) * u.white_si;
+  c.random_walk = node.NonNegative(u.random_walk_key, 0.0) * u.random_walk_si;
+  c.white_noise = node.NonNegative(u.white_key, 0.0) * u.white_si;
   c.scale_factor = ParseAxisConstant(node, "scale_factor_ppm", "scale_factor_fixed_ppm", kPpm);
   c.misalignment = ParseMatrixConstant(node, "misalignment_arcsec", "misalignment_fixed_arcsec", kArcsec_rad);
   if (c.misalignment.fixed && c.misalignment.fixed->diagonal().cwiseAbs().maxCoeff() > 0.0) {
     node.Fail("misalignment_fixed_arcsec", "the diagonal must be 0 (scale factors are the diagonal)");
   }
-  c.quantum = node.Double(u.quantum_key, 0.0, 0.0, kNoUpperBound);
+  c.quantum = node.NonNegative(u.quantum_key, 0.0);
   ParseTemperatureSensitivity(node.Child("temperature"), u, &c);
   return c;
 }
@@ -128,7 +127,7 @@ TemperatureProfile ParseTemperatureProfile(const ConfigNode& node) {
   p.reference_degC = node.Double("reference_degC", p.reference_degC, kAbsZero_degC, kMax_degC);
   p.initial_degC = node.Double("initial_degC", p.reference_degC, kAbsZero_degC, kMax_degC);
   p.final_degC = node.Double("final_degC", p.initial_degC, kAbsZero_degC, kMax_degC);
-  p.time_constant_s = node.Double("time_constant_s", 0.0, 0.0, kNoUpperBound);
+  p.time_constant_s = node.NonNegative("time_constant_s", 0.0);
   if (p.final_degC != p.initial_degC && !(p.time_constant_s > 0.0)) {
     node.Fail("time_constant_s", "required (> 0) when final_degC differs from initial_degC");
   }
