@@ -12,15 +12,14 @@
 #include <utility>
 #include <vector>
 
+#include <ceres/cost_function.h>
 #include <ceres/covariance.h>
 #include <ceres/crs_matrix.h>
 #include <ceres/iteration_callback.h>
 #include <ceres/solver.h>
-#include <Eigen/OrderingMethods>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 
 #include "core/linalg.h"
+#include "solvers/selected_inversion.h"
 
 namespace navtwin {
 namespace {
@@ -373,147 +372,21 @@ void BlockCovarianceBySparseQr(ceres::Problem& problem, const std::vector<const 
   RejectInflated(inflation, options.min_reciprocal_condition_number, result);
 }
 
-/// The lower triangle of the factor by columns, row indices increasing (strictly below
-/// the diagonal; L has a unit diagonal).
-struct LowerFactor {
-  std::vector<int> start;  ///< column j holds entries [start[j], start[j + 1])
-  std::vector<int> rows;
-  std::vector<double> values;
-
-  /// Index of entry (row, column), row > column, or -1 when not in the pattern.
-  int Find(int row, int column) const {
-    const auto first = rows.begin() + start[column];
-    const auto last = rows.begin() + start[column + 1];
-    const auto it = std::lower_bound(first, last, row);
-    return (it != last && *it == row) ? static_cast<int>(it - rows.begin()) : -1;
-  }
-};
-
 void BlockCovarianceBySelectedInversion(ceres::Problem& problem, const std::vector<const double*>& blocks,
                                         const TangentJacobian& jacobian, const BlockCovarianceOptions& options,
                                         BlockCovarianceResult* result) {
-  const ceres::CRSMatrix& crs = jacobian.crs;
-  const int n = crs.num_cols;
   const std::unordered_map<const double*, int> columns = ColumnMap(jacobian);
-  const auto fail_all = [&](const std::string& message) {
+  std::vector<std::pair<int, int>> dense;
+  for (std::size_t b = 0; b < jacobian.blocks.size(); ++b) {
+    dense.emplace_back(jacobian.offsets[b], problem.ParameterBlockTangentSize(jacobian.blocks[b]));
+  }
+  SelectedInverse inverse;
+  const std::string failure = inverse.Compute(jacobian.crs, dense);
+  if (!failure.empty()) {
     result->covariances.assign(blocks.size(), std::nullopt);
-    result->message = message;
-  };
-
-  // H = J^T J, plus explicit (zero) entries that make every free block's own square dense,
-  // so that its entries of H^-1 lie on the pattern of the filled matrix L + L^T.
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
-      crs.values.data());
-  Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(J.transpose()) * J;
-  {
-    std::vector<Eigen::Triplet<double>> pattern;
-    for (std::size_t b = 0; b < jacobian.blocks.size(); ++b) {
-      const int size = problem.ParameterBlockTangentSize(jacobian.blocks[b]);
-      for (int r = 0; r < size; ++r) {
-        for (int c = 0; c < size; ++c) pattern.emplace_back(jacobian.offsets[b] + r, jacobian.offsets[b] + c, 0.0);
-      }
-    }
-    Eigen::SparseMatrix<double> P(n, n);
-    P.setFromTriplets(pattern.begin(), pattern.end());
-    H = Eigen::SparseMatrix<double>(H + P);
-  }
-  H.makeCompressed();
-
-  // Jacobi scaling Hs = S H S, S = diag(1 / sqrt(H_ii)): unit diagonal, so the pivots of
-  // its LDL^T lie in (0, 1] and the variance inflation of coordinate i is Zs_ii.
-  Eigen::VectorXd scale(n);
-  for (int i = 0; i < n; ++i) {
-    const double hii = H.coeff(i, i);
-    if (!(hii > 0.0) || !std::isfinite(hii)) {
-      std::ostringstream text;
-      text << "covariance not computable (selected inversion): tangent column " << i
-           << " of the Jacobian is zero or not finite";
-      fail_all(text.str());
-      return;
-    }
-    scale(i) = 1.0 / std::sqrt(hii);
-  }
-  for (int k = 0; k < H.outerSize(); ++k) {
-    for (Eigen::SparseMatrix<double>::InnerIterator it(H, k); it; ++it) it.valueRef() *= scale(it.row()) * scale(it.col());
-  }
-
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt(H);
-  if (ldlt.info() != Eigen::Success) {
-    fail_all("covariance not computable (selected inversion): the LDL^T factorisation failed (J rank deficient)");
+    result->message = "covariance not computable (selected inversion): " + failure;
     return;
   }
-  // A pivot that is not positive: J^T J is singular (or indefinite by rounding). A tiny
-  // positive one shows as a large variance inflation of the coordinates it touches.
-  const Eigen::VectorXd d = ldlt.vectorD();
-  for (int j = 0; j < n; ++j) {
-    if (!(d(j) > 0.0) || !std::isfinite(d(j))) {
-      std::ostringstream text;
-      text << "covariance not computable (selected inversion): J is rank deficient (LDL^T pivot " << d(j)
-           << " of the Jacobi-scaled J^T J)";
-      fail_all(text.str());
-      return;
-    }
-  }
-  // perm[i]: index in the factored (permuted) matrix of original column i.
-  const Eigen::VectorXi perm = ldlt.permutationP().indices();
-
-  LowerFactor L;
-  {
-    const Eigen::SparseMatrix<double> factor = ldlt.matrixL().nestedExpression();
-    L.start.assign(n + 1, 0);
-    std::vector<std::pair<int, double>> column;
-    for (int j = 0; j < n; ++j) {
-      column.clear();
-      for (Eigen::SparseMatrix<double>::InnerIterator it(factor, j); it; ++it) {
-        if (it.row() > j) column.emplace_back(static_cast<int>(it.row()), it.value());
-      }
-      std::sort(column.begin(), column.end());
-      for (const auto& entry : column) {
-        L.rows.push_back(entry.first);
-        L.values.push_back(entry.second);
-      }
-      L.start[j + 1] = static_cast<int>(L.rows.size());
-    }
-  }
-
-  // Selected inversion, backwards over the columns: Z = Hs^-1 on the pattern of L
-  // (z_offdiag aligned with L's entries) and its diagonal. For column j with rows
-  // r_1 < ... < r_m: every entry Z_{r_a r_b} needed lies in column min(r_a, r_b) of the
-  // pattern (the rows of a column of L form a clique of the filled graph), so iterating
-  // column r_b of Z and keeping the rows marked as belonging to column j finds them all.
-  std::vector<double> z_diag(n, 0.0);
-  std::vector<double> z_offdiag(L.values.size(), 0.0);
-  std::vector<int> position(n, -1);  // position[r] = entry index in column j, -1 if absent
-  for (int j = n - 1; j >= 0; --j) {
-    const int begin = L.start[j], end = L.start[j + 1];
-    for (int a = begin; a < end; ++a) position[L.rows[a]] = a;
-    for (int b = begin; b < end; ++b) {
-      const int c = L.rows[b];
-      const double l_b = L.values[b];
-      z_offdiag[b] -= z_diag[c] * l_b;
-      for (int e = L.start[c]; e < L.start[c + 1]; ++e) {
-        const int a = position[L.rows[e]];
-        if (a < 0) continue;
-        // Z_{r_a c} = Z_{c r_a} with r_a > c: it enters Z_{r_a j} (through l_cj) and Z_{c j}
-        // (through l_{r_a j}).
-        z_offdiag[a] -= z_offdiag[e] * l_b;
-        z_offdiag[b] -= z_offdiag[e] * L.values[a];
-      }
-    }
-    double diag = 1.0 / d(j);
-    for (int a = begin; a < end; ++a) {
-      diag -= L.values[a] * z_offdiag[a];
-      position[L.rows[a]] = -1;
-    }
-    z_diag[j] = diag;
-  }
-  const auto z = [&](int p, int q) -> double {  // Zs in the permuted indices, on the pattern
-    if (p == q) return z_diag[p];
-    const int e = p > q ? L.Find(p, q) : L.Find(q, p);
-    return e >= 0 ? z_offdiag[e] : std::numeric_limits<double>::quiet_NaN();
-  };
-
   std::vector<Eigen::VectorXd> inflation(blocks.size());
   for (std::size_t i = 0; i < blocks.size(); ++i) {
     const int size = problem.ParameterBlockTangentSize(blocks[i]);
@@ -525,16 +398,15 @@ void BlockCovarianceBySelectedInversion(ceres::Problem& problem, const std::vect
     Eigen::MatrixXd block(size, size);
     inflation[i].resize(size);
     for (int r = 0; r < size; ++r) {
-      const int orig_r = column->second + r;
       for (int c = 0; c <= r; ++c) {
-        const int orig_c = column->second + c;
-        block(r, c) = block(c, r) = scale(orig_r) * scale(orig_c) * z(perm(orig_r), perm(orig_c));
+        block(r, c) = block(c, r) = inverse.Inverse(column->second + r, column->second + c);
       }
-      inflation[i](r) = z_diag[perm(orig_r)];
+      inflation[i](r) = inverse.Inflation(column->second + r);
     }
     if (!block.allFinite()) {
-      fail_all("covariance not computable (selected inversion): internal error, a block entry is off the "
-               "factor's pattern");
+      result->covariances.assign(blocks.size(), std::nullopt);
+      result->message = "covariance not computable (selected inversion): internal error, a block entry is off "
+                        "the factor's pattern";
       return;
     }
     result->covariances[i] = block;
@@ -562,6 +434,72 @@ BlockCovarianceResult ComputeBlockDiagonalCovariance(ceres::Problem& problem, co
     BlockCovarianceBySparseQr(problem, blocks, jacobian, options, &result);
   } else {
     BlockCovarianceBySelectedInversion(problem, blocks, jacobian, options, &result);
+  }
+  result.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+
+LeverageResult ComputeResidualLeverages(ceres::Problem& problem, const std::vector<ceres::ResidualBlockId>& blocks,
+                                        int num_threads) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<ceres::ResidualBlockId> all;
+  problem.GetResidualBlocks(&all);
+  std::unordered_map<ceres::ResidualBlockId, int> first_row;
+  int rows = 0;
+  for (ceres::ResidualBlockId id : all) {
+    first_row.emplace(id, rows);
+    rows += problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+  }
+  for (ceres::ResidualBlockId id : blocks) {
+    if (first_row.count(id) == 0) throw std::invalid_argument("ComputeResidualLeverages: a block not in the problem");
+  }
+  LeverageResult result;
+  TangentJacobian jacobian;
+  std::vector<double*> parameters;
+  problem.GetParameterBlocks(&parameters);
+  for (double* block : parameters) {
+    if (problem.IsParameterBlockConstant(block)) continue;
+    jacobian.offsets.push_back(jacobian.blocks.empty() ? 0
+                                                       : jacobian.offsets.back() +
+                                                             problem.ParameterBlockTangentSize(jacobian.blocks.back()));
+    jacobian.blocks.push_back(block);
+  }
+  SelectedInverse inverse;
+  if (!jacobian.blocks.empty()) {
+    ceres::Problem::EvaluateOptions evaluate;
+    evaluate.parameter_blocks = jacobian.blocks;
+    evaluate.residual_blocks = all;
+    evaluate.num_threads = num_threads;
+    if (!problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &jacobian.crs)) {
+      result.message = "leverages not computable: the problem could not be evaluated";
+      return result;
+    }
+    std::vector<std::pair<int, int>> dense;
+    for (std::size_t b = 0; b < jacobian.blocks.size(); ++b) {
+      dense.emplace_back(jacobian.offsets[b], problem.ParameterBlockTangentSize(jacobian.blocks[b]));
+    }
+    const std::string failure = inverse.Compute(jacobian.crs, dense);
+    if (!failure.empty()) {
+      result.message = "leverages not computable (selected inversion): " + failure;
+      return result;
+    }
+  }
+  const ceres::CRSMatrix& J = jacobian.crs;
+  for (ceres::ResidualBlockId id : blocks) {
+    const int size = problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+    Eigen::VectorXd h = Eigen::VectorXd::Zero(size);
+    for (int r = 0; r < size && !jacobian.blocks.empty(); ++r) {
+      const int row = first_row[id] + r;
+      double sum = 0.0;
+      for (int a = J.rows[row]; a < J.rows[row + 1]; ++a) {
+        for (int b = J.rows[row]; b < J.rows[row + 1]; ++b) {
+          sum += J.values[a] * J.values[b] * inverse.Inverse(J.cols[a], J.cols[b]);
+        }
+      }
+      h(r) = sum;
+    }
+    result.leverages.push_back(h);
   }
   result.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -142,4 +142,25 @@ BlockCovarianceResult ComputeBlockDiagonalCovariance(ceres::Problem& problem,
                                                      const std::vector<const double*>& blocks,
                                                      const BlockCovarianceOptions& options = BlockCovarianceOptions());
 
+// ---------------------------------------------------------------------------------------
+// Leverages of residual rows (redundancy numbers)
+
+struct LeverageResult {
+  /// Per requested residual block, in order: the leverage of each of its rows; all empty
+  /// when the inverse could not be computed.
+  std::vector<Eigen::VectorXd> leverages;
+  std::string message;  ///< why it failed; empty on success
+  double run_time_s = 0.0;
+};
+
+/// The leverage of every row i of the requested residual blocks, h_i = J_i (J^T J)^-1 J_i^T,
+/// J the Jacobian of all residual blocks over the free tangent parameters at the current
+/// values (robustified where a block has a loss, as Ceres evaluates it), by selected
+/// inversion (solvers/selected_inversion.h). For whitened residuals 0 <= h_i <= 1, 1 - h_i
+/// is the row's redundancy number (Foerstner 1979), and the leverages of all rows of the
+/// problem sum to the number of free tangent parameters. A block with no free parameter
+/// has leverages 0. Throws std::invalid_argument for a block not in the problem.
+LeverageResult ComputeResidualLeverages(ceres::Problem& problem, const std::vector<ceres::ResidualBlockId>& blocks,
+                                        int num_threads = 1);
+
 }  // namespace navtwin

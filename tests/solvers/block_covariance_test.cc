@@ -290,5 +290,50 @@ TEST(BlockCovariance, InvalidRequestsThrow) {
   EXPECT_THROW(ComputeBlockDiagonalCovariance(problem, {&a, &a}), std::invalid_argument);
 }
 
+// ComputeResidualLeverages: h_i = J_i (J^T J)^-1 J_i^T of every row against the dense
+// formula, on the same chain (scales 1e-3 to 1e3); they sum to the number of parameters
+// (the trace of the hat matrix). Tolerance 1e-8: the dense inverse of a matrix whose
+// condition number reaches ~1e12 loses about that much.
+TEST(ResidualLeverages, EqualDenseHatMatrixDiagonal) {
+  std::mt19937 rng(11);
+  Chain chain;
+  BuildChain(30, rng, &chain);
+  std::vector<ceres::ResidualBlockId> ids;
+  chain.problem.GetResidualBlocks(&ids);
+  const LeverageResult result = ComputeResidualLeverages(chain.problem, ids);
+  ASSERT_TRUE(result.message.empty()) << result.message;
+  ASSERT_EQ(result.leverages.size(), ids.size());
+  const Eigen::MatrixXd hat = chain.J * (chain.J.transpose() * chain.J).inverse() * chain.J.transpose();
+  int row = 0;
+  double sum = 0.0;
+  for (const Eigen::VectorXd& h : result.leverages) {
+    for (Eigen::Index r = 0; r < h.size(); ++r, ++row) {
+      EXPECT_NEAR(h(r), hat(row, row), 1e-8) << "row " << row;
+      EXPECT_GE(h(r), -1e-8);
+      EXPECT_LE(h(r), 1.0 + 1e-8);
+      sum += h(r);
+    }
+  }
+  EXPECT_EQ(row, chain.J.rows());
+  EXPECT_NEAR(sum, chain.columns, 1e-6);
+}
+
+// A constant block adds no column: a residual on it alone has leverage 0, and the others
+// sum to the free parameters.
+TEST(ResidualLeverages, ConstantBlockHasNoLeverage) {
+  std::mt19937 rng(12);
+  Chain chain;
+  BuildChain(6, rng, &chain);
+  chain.problem.SetParameterBlockConstant(chain.x[0].data());
+  std::vector<ceres::ResidualBlockId> ids;
+  chain.problem.GetResidualBlocks(&ids);
+  const LeverageResult result = ComputeResidualLeverages(chain.problem, ids);
+  ASSERT_TRUE(result.message.empty()) << result.message;
+  EXPECT_NEAR(result.leverages.front().sum(), 0.0, 1e-12);  // the prior on block 0
+  double sum = 0.0;
+  for (const Eigen::VectorXd& h : result.leverages) sum += h.sum();
+  EXPECT_NEAR(sum, chain.columns - static_cast<int>(chain.x[0].size()), 1e-8);
+}
+
 }  // namespace solvers_block_covariance_test
 }  // namespace navtwin
