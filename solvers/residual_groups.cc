@@ -1,5 +1,6 @@
 #include "solvers/residual_groups.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -151,14 +152,20 @@ std::vector<ResidualGroupStats> ResidualGroups::Evaluate(ceres::Problem& problem
   return stats;
 }
 
-double ResidualGroups::UpdateFactors(const std::vector<ResidualGroupStats>& stats, double min_redundancy) {
-  double worst = 0.0;
-  for (std::size_t g = 0; g < stats.size() && g < data_->factors.size(); ++g) {
+double ResidualGroups::UpdateFactors(const std::vector<ResidualGroupStats>& stats, double min_redundancy,
+                                     double tolerance) {
+  const auto estimated = [&](std::size_t g) {
     const ResidualGroupStats& s = stats[g];
-    if (!data_->estimable[g] || !(s.redundancy >= min_redundancy) || !(s.chi2 > 0.0)) continue;
-    const double ratio = s.ChiSquarePerDof();
-    worst = std::max(worst, std::abs(ratio - 1.0));
-    data_->factors[g] *= ratio;
+    return data_->estimable[g] && s.redundancy >= min_redundancy && s.chi2 > 0.0;
+  };
+  const std::size_t n = std::min(stats.size(), data_->factors.size());
+  double worst = 0.0;
+  for (std::size_t g = 0; g < n; ++g) {
+    if (estimated(g)) worst = std::max(worst, std::abs(stats[g].ChiSquarePerDof() - 1.0));
+  }
+  if (worst <= tolerance) return worst;
+  for (std::size_t g = 0; g < n; ++g) {
+    if (estimated(g)) data_->factors[g] *= stats[g].ChiSquarePerDof();
   }
   return worst;
 }

@@ -66,10 +66,10 @@ class ResidualGroups {
   std::vector<ResidualGroupStats> Evaluate(ceres::Problem& problem, bool redundancy, int num_threads,
                                            std::string* message) const;
 
-  /// One step of the iterated estimator: s_k *= chi2_k / red_k for the estimable groups
-  /// with red_k >= min_redundancy. Returns the largest |chi2_k / red_k - 1| among them (0
-  /// when none).
-  double UpdateFactors(const std::vector<ResidualGroupStats>& stats, double min_redundancy);
+  /// One step of the iterated estimator: the largest |chi2_k / red_k - 1| over the estimable
+  /// groups with red_k >= min_redundancy (0 when none); when it exceeds `tolerance`,
+  /// s_k *= chi2_k / red_k for each of them. Returns that largest deviation.
+  double UpdateFactors(const std::vector<ResidualGroupStats>& stats, double min_redundancy, double tolerance = 0.0);
 
   struct Data;  ///< names, estimable flags and factors (defined in the .cc)
 

@@ -35,12 +35,30 @@
 #include "problems/gnss_ins/sources.h"
 #include "problems/ins/measurement_rules.h"
 #include "solvers/batch_driver.h"
+#include "solvers/residual_groups.h"
 #include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
 
 using ins::AidingSource;
+
+/// Residual groups of the batch's own residuals (the sources name theirs). The IMU factor is
+/// whitened by S = L^-1 (L the lower Cholesky factor of its covariance, order attitude,
+/// velocity, position): S is lower triangular, so its first three rows see the attitude
+/// residual alone (the gyro noise) and the other six the velocity and position residuals
+/// given the attitude one (mostly the accelerometer noise).
+constexpr const char* kImuRotationGroup = "imu_rotation";
+constexpr const char* kImuTranslationGroup = "imu_velocity_position";
+constexpr const char* kPriorGroup = "prior";
+/// Variance components: a group's factor is estimated when its redundancy is at least this
+/// (its chi-square per degree of freedom then has a relative std of sqrt(2 / 10) = 0.45 or
+/// less); the rounds stop when every estimable group's chi2 / dof is within the tolerance
+/// of 1: 10 % in variance is 5 % in sigma, below the estimate's own scatter for groups of
+/// up to 800 dof (sqrt(2 / 800) = 5 %). The iteration converges linearly, slowest for groups
+/// that share states (IMU and bias processes): a few rounds reach 10 %, 5 % can take ten.
+constexpr double kMinVarianceRedundancy = 10.0;
+constexpr double kVarianceTolerance = 0.1;
 
 double Seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
@@ -136,6 +154,24 @@ BiasModel MakeBiasModel(double steady_std, double tau_s, const Eigen::Vector3d& 
   return m;
 }
 
+/// Per group: the final statistics, the sigma scale and chi2 / dof with the configured noise.
+std::map<std::string, ResidualStats> ResidualSummary(const std::vector<ResidualGroupStats>& configured,
+                                                     const std::vector<ResidualGroupStats>& final_stats) {
+  std::map<std::string, ResidualStats> out;
+  for (std::size_t g = 0; g < final_stats.size(); ++g) {
+    const ResidualGroupStats& f = final_stats[g];
+    if (f.rows == 0) continue;
+    ResidualStats& r = out[f.name];
+    r.rows = f.rows;
+    r.chi2 = f.chi2;
+    r.dof = f.redundancy;
+    r.sigma_scale = std::sqrt(f.factor);
+    r.adapted = f.factor != 1.0;
+    if (g < configured.size()) r.configured_chi2_per_dof = configured[g].ChiSquarePerDof();
+  }
+  return out;
+}
+
 class BatchSmoother : public ins::BatchAccess {
  public:
   BatchSmoother(const Inputs& inputs, const GnssInsConfig& config, const Solution& start, const FilterStart* initial,
@@ -157,7 +193,7 @@ class BatchSmoother : public ins::BatchAccess {
   double* aux(int i) override { return &aux_[static_cast<std::size_t>(aux_begin_[current_] + i)]; }
   void Add(ceres::CostFunction* cost, bool robust, const std::vector<double*>& blocks,
            const std::string& key) override {
-    problem_->AddResidualBlock(cost, robust ? huber_.get() : nullptr, blocks);
+    problem_->AddResidualBlock(groups_.Wrap(cost, SourceRowGroups(key)), robust ? huber_.get() : nullptr, blocks);
     ++counts_[key].used;
   }
   void Count(const std::string& key, bool used) override {
@@ -175,7 +211,14 @@ class BatchSmoother : public ins::BatchAccess {
   void AddPriors();
   void AddAuxPriors();
   int Reintegrate();
+  BatchReport SolveWithReintegration(const BatchOptions& options, const std::string& label,
+                                     std::ostringstream* report);
+  void AdaptNoise(const BatchOptions& options, std::ostringstream* report);
   void Covariance(Solution* solution, std::ostringstream* report);
+  std::vector<int> SourceRowGroups(const std::string& key);
+  ceres::CostFunction* Group(ceres::CostFunction* cost, const char* group, bool estimable = true) {
+    return groups_.Wrap(cost, {groups_.Group(group, estimable)});
+  }
   void Say(const std::string& line) const {
     if (progress_ != nullptr) *progress_ << "batch: " << line << '\n' << std::flush;
   }
@@ -201,6 +244,10 @@ class BatchSmoother : public ins::BatchAccess {
   std::vector<ceres::ResidualBlockId> imu_factors_;
   std::map<std::string, MeasurementCount> counts_;
   std::size_t imu_samples_ = 0;
+  ResidualGroups groups_;
+  std::map<std::string, std::vector<int>> source_groups_;  ///< "source index/key" -> row groups
+  std::vector<ResidualGroupStats> configured_stats_;        ///< with the configured noise
+  std::vector<ResidualGroupStats> final_stats_;
 
   // Declared before the problem, which does not own them (shared by many blocks).
   PositionManifold position_manifold_;
@@ -386,7 +433,11 @@ void BatchSmoother::MechanizeAndPreintegrate() {
 void BatchSmoother::AddImuFactor(std::size_t i) {
   BatchState& a = states_[i];
   BatchState& b = states_[i + 1];
-  imu_factors_[i] = problem_->AddResidualBlock(CreateImuFactor(pre_[i]), nullptr,
+  const int rotation = groups_.Group(kImuRotationGroup), translation = groups_.Group(kImuTranslationGroup);
+  imu_factors_[i] = problem_->AddResidualBlock(
+      groups_.Wrap(CreateImuFactor(pre_[i]), {rotation, rotation, rotation, translation, translation, translation,
+                                              translation, translation, translation}),
+      nullptr,
                                                {a.pos.data(), a.vel.data(), a.q.data(), a.bg_block, a.ba_block,
                                                 b.pos.data(), b.vel.data(), b.q.data()});
 }
@@ -408,19 +459,22 @@ void BatchSmoother::AddPriors() {
   const Eigen::VectorXd std = InitialStdVector(cfg_, err::kSize15);
   BatchState& s = states_.front();
   const NavState& c = centre.nav;
+  const auto prior = [this](ceres::CostFunction* cost) { return Group(cost, kPriorGroup, false); };
   problem_->AddResidualBlock(
-      PositionPrior::Create(Eigen::Vector3d(c.lat_rad, c.lon_rad, c.h_m), std.segment<3>(err::kPos).cwiseMax(1e-6)),
+      prior(PositionPrior::Create(Eigen::Vector3d(c.lat_rad, c.lon_rad, c.h_m), std.segment<3>(err::kPos).cwiseMax(1e-6))),
       nullptr, s.pos.data());
-  problem_->AddResidualBlock(VectorPrior3::Create(c.v_n_mps, std.segment<3>(err::kVel).cwiseMax(1e-6)), nullptr,
+  problem_->AddResidualBlock(prior(VectorPrior3::Create(c.v_n_mps, std.segment<3>(err::kVel).cwiseMax(1e-6))), nullptr,
                              s.vel.data());
   const Eigen::Vector3d att_std = std.segment<3>(err::kAtt).cwiseMax(1e-8);
-  problem_->AddResidualBlock(AttitudePrior::Create(c.q_n_b, Eigen::Matrix3d(att_std.cwiseInverse().asDiagonal())), nullptr,
-                             s.q.data());
+  problem_->AddResidualBlock(
+      prior(AttitudePrior::Create(c.q_n_b, Eigen::Matrix3d(att_std.cwiseInverse().asDiagonal()))), nullptr,
+      s.q.data());
   if (!gyro_model_.constant) {
-    problem_->AddResidualBlock(VectorPrior3::Create(centre.imu.bg_radps, gyro_model_.prior_std), nullptr, s.bg_block);
+    problem_->AddResidualBlock(prior(VectorPrior3::Create(centre.imu.bg_radps, gyro_model_.prior_std)), nullptr,
+                               s.bg_block);
   }
   if (!accel_model_.constant) {
-    problem_->AddResidualBlock(VectorPrior3::Create(centre.imu.ba_mps2, accel_model_.prior_std), nullptr,
+    problem_->AddResidualBlock(prior(VectorPrior3::Create(centre.imu.ba_mps2, accel_model_.prior_std)), nullptr,
                                s.ba_block);
   }
 }
@@ -448,11 +502,15 @@ void BatchSmoother::BuildProblem() {
     AddImuFactor(i);
     const double dt = states_[i + 1].t_s - states_[i].t_s;
     if (!gyro_model_.shared) {
-      problem_->AddResidualBlock(BiasGaussMarkov::Create(dt, gyro_model_.tau_s, gyro_model_.steady_std), nullptr,
+      problem_->AddResidualBlock(Group(BiasGaussMarkov::Create(dt, gyro_model_.tau_s, gyro_model_.steady_std),
+                                       "gyro_bias_process"),
+                                 nullptr,
                                  states_[i].bg_block, states_[i + 1].bg_block);
     }
     if (!accel_model_.shared) {
-      problem_->AddResidualBlock(BiasGaussMarkov::Create(dt, accel_model_.tau_s, accel_model_.steady_std), nullptr,
+      problem_->AddResidualBlock(Group(BiasGaussMarkov::Create(dt, accel_model_.tau_s, accel_model_.steady_std),
+                                       "accel_bias_process"),
+                                 nullptr,
                                  states_[i].ba_block, states_[i + 1].ba_block);
     }
   }
@@ -470,8 +528,9 @@ void BatchSmoother::AddAuxPriors() {
     double* block = &aux_[i];
     if (!problem_->HasParameterBlock(block)) problem_->AddParameterBlock(block, 1);
     if (aux_states_[i].initial_std > 0.0) {
-      problem_->AddResidualBlock(ScalarPrior::Create(aux_states_[i].initial, aux_states_[i].initial_std), nullptr,
-                                 block);
+      problem_->AddResidualBlock(
+          Group(ScalarPrior::Create(aux_states_[i].initial, aux_states_[i].initial_std), kPriorGroup, false), nullptr,
+          block);
     } else {
       problem_->SetParameterBlockConstant(block);
     }
@@ -498,6 +557,83 @@ int BatchSmoother::Reintegrate() {
     ++count;
   }
   return count;
+}
+
+std::vector<int> BatchSmoother::SourceRowGroups(const std::string& key) {
+  const std::string id = std::to_string(current_) + "/" + key;
+  auto it = source_groups_.find(id);
+  if (it == source_groups_.end()) {
+    std::vector<int> groups;
+    const AidingSource& source = *sources_[current_];
+    for (const std::string& name : source.row_groups(key)) {
+      groups.push_back(groups_.Group(name, source.noise_estimable()));
+    }
+    it = source_groups_.emplace(id, std::move(groups)).first;
+  }
+  return it->second;
+}
+
+/// Solves, then reintegrates the intervals whose gyro bias moved and solves again, at most
+/// kMaxReintegrationRounds times.
+BatchReport BatchSmoother::SolveWithReintegration(const BatchOptions& options, const std::string& label,
+                                                  std::ostringstream* report) {
+  BatchReport solve = SolveBatch(*problem_, options, progress_);
+  *report << label << " 1: " << solve.brief_report << '\n';
+  for (int round = 1; round <= kMaxReintegrationRounds; ++round) {
+    const int reintegrated = Reintegrate();
+    if (reintegrated == 0) break;
+    std::ostringstream line;
+    line << "reintegration round " << round << ": " << reintegrated << " of " << pre_.size()
+         << " intervals (gyro bias moved past the threshold)";
+    *report << line.str() << '\n';
+    Say(line.str());
+    solve = SolveBatch(*problem_, options, progress_);
+    *report << label << " " << round + 1 << ": " << solve.brief_report << '\n';
+  }
+  return solve;
+}
+
+/// The residual statistics with the configured noise, and with config.batch.variance_components
+/// the iterated variance-component estimate: factors updated, problem solved again, until
+/// every estimable group's chi2 / dof is within kVarianceTolerance of 1.
+void BatchSmoother::AdaptNoise(const BatchOptions& options, std::ostringstream* report) {
+  const int threads = std::max(1, cfg_.batch.threads);
+  std::string failure;
+  configured_stats_ = groups_.Evaluate(*problem_, true, threads, &failure);
+  final_stats_ = configured_stats_;
+  if (!failure.empty()) {
+    *report << "residual statistics without redundancy: " << failure << '\n';
+    Say("residual statistics without redundancy: " + failure);
+    return;
+  }
+  if (!cfg_.batch.variance_components) return;
+  int round = 0;
+  double worst = 0.0;
+  for (; round < cfg_.batch.variance_rounds; ++round) {
+    worst = groups_.UpdateFactors(final_stats_, kMinVarianceRedundancy, kVarianceTolerance);
+    if (worst <= kVarianceTolerance) break;
+    std::ostringstream line;
+    line.precision(3);
+    line << "variance components round " << round + 1 << ": largest |chi2/dof - 1| " << worst
+         << ", noise rescaled, solving again";
+    Say(line.str());
+    *report << line.str() << '\n';
+    SolveWithReintegration(options, "vce solve", report);
+    final_stats_ = groups_.Evaluate(*problem_, true, threads, &failure);
+    if (!failure.empty()) break;
+  }
+  std::ostringstream line;
+  line.precision(3);
+  if (!failure.empty()) {
+    line << "variance components stopped: " << failure;
+  } else if (round == cfg_.batch.variance_rounds) {
+    line << "variance components not converged after " << round << " rounds (largest |chi2/dof - 1| "
+         << worst << ")";
+  } else {
+    line << "variance components converged after " << round << " round(s)";
+  }
+  *report << line.str() << '\n';
+  Say(line.str());
 }
 
 void BatchSmoother::Covariance(Solution* solution, std::ostringstream* report) {
@@ -572,19 +708,8 @@ Solution BatchSmoother::Run() {
   options.function_tolerance = 1e-8;  // |cost change| / cost: far below one unit of chi-square
   options.progress = progress_ != nullptr;
   std::ostringstream report;
-  BatchReport solve = SolveBatch(*problem_, options, progress_);
-  report << "solve 1: " << solve.brief_report << '\n';
-  for (int round = 1; round <= kMaxReintegrationRounds; ++round) {
-    const int reintegrated = Reintegrate();
-    if (reintegrated == 0) break;
-    std::ostringstream line;
-    line << "reintegration round " << round << ": " << reintegrated << " of " << pre_.size()
-         << " intervals (gyro bias moved past the threshold)";
-    report << line.str() << '\n';
-    Say(line.str());
-    solve = SolveBatch(*problem_, options, progress_);
-    report << "solve " << round + 1 << ": " << solve.brief_report << '\n';
-  }
+  SolveWithReintegration(options, "solve", &report);
+  AdaptNoise(options, &report);
 
   Solution solution;
   solution.method = "batch";
@@ -606,6 +731,7 @@ Solution BatchSmoother::Run() {
   }
   if (cfg_.batch.covariance) Covariance(&solution, &report);
   solution.counts = counts_;
+  solution.residuals = ResidualSummary(configured_stats_, final_stats_);
   for (const ins::AuxState& a : aux_states_) solution.aux_names.push_back(a.name);
   solution.solver_report = report.str();
   if (!solution.solver_report.empty() && solution.solver_report.back() == '\n') solution.solver_report.pop_back();

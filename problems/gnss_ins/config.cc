@@ -403,7 +403,7 @@ FilterConfig ParseFilter(const ConfigNode& n) {
 
 BatchConfig ParseBatch(const ConfigNode& n) {
   n.RequireKeys({"state_interval_s", "max_state_interval_s", "huber_k", "max_iterations", "threads",
-                 "covariance", "relinearize_bias_deg_h"});
+                 "covariance", "relinearize_bias_deg_h", "variance_components", "variance_rounds"});
   BatchConfig x;
   x.state_interval_s = NonNegative(n, "state_interval_s", x.state_interval_s);
   x.max_state_interval_s = Sigma(n, "max_state_interval_s", x.max_state_interval_s);
@@ -413,6 +413,8 @@ BatchConfig ParseBatch(const ConfigNode& n) {
   x.covariance = n.Bool("covariance", x.covariance);
   x.relinearize_bias_radps =
       NonNegative(n, "relinearize_bias_deg_h", x.relinearize_bias_radps / kDegPerHour_radps) * kDegPerHour_radps;
+  x.variance_components = n.Bool("variance_components", x.variance_components);
+  x.variance_rounds = n.Int("variance_rounds", x.variance_rounds, 1, 1000);
   return x;
 }
 

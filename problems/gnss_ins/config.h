@@ -101,6 +101,10 @@ struct BatchConfig {
   int threads = 1;
   bool covariance = true;          ///< per-state standard deviations from ceres::Covariance
   double relinearize_bias_radps = 0.0;  ///< re-preintegrate when a gyro bias moves more (0: auto)
+  /// Variance-component estimation: each residual group's noise scaled to fit its residuals
+  /// (solvers/residual_groups.h), re-solving up to variance_rounds times.
+  bool variance_components = true;
+  int variance_rounds = 10;
 };
 
 struct GnssInsConfig {

@@ -210,6 +210,40 @@ void AppendAuxStates(std::string* s, const GnssInsRun& run) {
   }
 }
 
+/// Below this many degrees of freedom a group's chi2 / dof says nothing (a bias process that
+/// its own rows determine has almost none); the table shows "-".
+constexpr double kMinReportedDof = 1.0;
+
+/// Per method, per residual group: rows, chi2 / dof (with the configured noise and, after
+/// variance-component estimation, the adapted one) and the sigma scale.
+void AppendResidualStats(std::string* s, const GnssInsRun& run) {
+  bool any = false;
+  for (const MethodRun& m : run.methods) any = any || !m.solution.residuals.empty();
+  if (!any) return;
+  Append(s, "residuals (whitened; chi2/dof near 1 when the noise fits; batch: sigma scale from variance components):\n");
+  Append(s, "%-7s %-22s %8s %8s %10s %10s %10s %10s\n", "method", "group", "rows", "dof", "rejected", "chi2/dof",
+         "sigma x", "chi2/dof");
+  Append(s, "%-7s %-22s %8s %8s %10s %10s %10s %10s\n", "", "", "", "", "", "configured", "", "adapted");
+  for (const MethodRun& m : run.methods) {
+    for (const auto& [name, r] : m.solution.residuals) {
+      const auto count = m.solution.counts.find(name);
+      const std::size_t rejected = count == m.solution.counts.end() ? 0 : count->second.rejected;
+      const double configured = std::isnan(r.configured_chi2_per_dof) ? r.ChiSquarePerDof() : r.configured_chi2_per_dof;
+      Append(s, "%-7s %-22s %8zu %8.1f %10zu", m.name.c_str(), name.c_str(), r.rows, r.dof, rejected);
+      if (r.dof >= kMinReportedDof) {
+        Append(s, " %10.3f", configured);
+      } else {
+        Append(s, " %10s", "-");
+      }
+      if (r.adapted) {
+        Append(s, " %10.3f %10.3f\n", r.sigma_scale, r.ChiSquarePerDof());
+      } else {
+        Append(s, " %10s %10s\n", "-", "-");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 InputSummary SummarizeInputs(const Inputs& inputs) {
@@ -311,6 +345,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
     for (const MethodRun& m : run.methods) {
       Append(&s, "%-7s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
     }
+    AppendResidualStats(&s, run);
     return s;
   }
   const ScoreReport& first = *run.methods.front().errors;
@@ -323,6 +358,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   Append(&s, " %10s\n", "run [s]");
   for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
   AppendAuxStates(&s, run);
+  AppendResidualStats(&s, run);
   return s;
 }
 

@@ -2,6 +2,8 @@
 // command and the tests compare them directly.
 #pragma once
 
+#include <cstddef>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -15,6 +17,22 @@ struct MeasurementCount {
   std::size_t rejected = 0;  ///< by the chi-square gate (filter) or not used for another reason
 };
 
+/// Residuals of one group of measurement rows (a sensor, or one axis group of a sensor):
+/// how well the configured noise fits them. A consistent estimator has chi2 / dof near 1.
+struct ResidualStats {
+  std::size_t rows = 0;  ///< scalar residuals (filter: summed dimensions of the accepted updates)
+  double chi2 = 0.0;     ///< sum of squared whitened residuals (filter: NIS of the accepted updates)
+  /// Degrees of freedom: batch, the redundancy sum (1 - h_i) (solvers/residual_groups.h);
+  /// filter, the rows (E[NIS] = dimension).
+  double dof = 0.0;
+  /// Batch: the factor the group's standard deviations were multiplied by (variance-component
+  /// estimation; 1 without), and chi2 / dof with the configured standard deviations.
+  double sigma_scale = 1.0;
+  double configured_chi2_per_dof = std::numeric_limits<double>::quiet_NaN();
+  bool adapted = false;  ///< the estimation changed the factor (enough redundancy)
+  double ChiSquarePerDof() const { return chi2 / dof; }
+};
+
 struct Solution {
   std::string method;  ///< "filter", "rts", "batch"
   /// The estimator's state epochs ("knots"), increasing in time, with error-state standard
@@ -23,6 +41,10 @@ struct Solution {
   std::vector<NavEpoch> epochs;
   /// Keys: "gnss_position", "gnss_velocity", "mag", "baro", "zupt".
   std::map<std::string, MeasurementCount> counts;
+  /// Per residual group: the sources' count keys or their axis groups ("gnss_position_h",
+  /// "gnss_position_v", ...; AidingSource::row_groups), and for the batch "imu" (the
+  /// preintegrated increments), "gyro_bias_process", "accel_bias_process", "prior".
+  std::map<std::string, ResidualStats> residuals;
   /// Names of the epochs' auxiliary states (NavEpoch::aux; the aiding sources' parameters,
   /// e.g. "odometer_scale"), in order.
   std::vector<std::string> aux_names;

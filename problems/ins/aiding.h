@@ -124,6 +124,15 @@ class AidingSource {
   virtual ~AidingSource() = default;
   /// Count keys, in the order they are reported.
   virtual std::vector<std::string> keys() const = 0;
+  /// The residual groups of the rows of a measurement counted under `key` (statistics and
+  /// noise estimation, solvers/residual_groups.h): one name for every row, or one per row
+  /// (e.g. horizontal and vertical axes of a GNSS position).
+  virtual std::vector<std::string> row_groups(const std::string& key) const { return {key}; }
+  /// Whether the batch may estimate the noise of this source's residual groups (variance
+  /// components). False for pseudo-measurements whose sigma is a modelling choice (ZUPT,
+  /// NHC): tightening one pins the states it touches, its redundancy collapses and the
+  /// estimate runs away.
+  virtual bool noise_estimable() const { return true; }
   virtual Timing timing() const = 0;
   /// Sample times, increasing (empty for kEveryEpoch).
   virtual const std::vector<double>& times() const = 0;

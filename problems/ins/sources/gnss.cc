@@ -25,6 +25,11 @@ class GnssSource : public AidingSource {
   }
 
   std::vector<std::string> keys() const override { return {kPosition, kVelocity, kReset}; }
+  /// North and east rows share a group, down has its own: receivers' vertical errors are
+  /// larger and differently mis-stated than their horizontal ones.
+  std::vector<std::string> row_groups(const std::string& key) const override {
+    return {key + "_h", key + "_h", key + "_v"};
+  }
   Timing timing() const override { return Timing::kExact; }
   const std::vector<double>& times() const override { return times_; }
   bool anchors_batch_states() const override { return true; }

@@ -27,6 +27,7 @@ class NhcSource : public AidingSource {
         still_rule_(still_rule) {}
 
   std::vector<std::string> keys() const override { return {kNhc}; }
+  bool noise_estimable() const override { return false; }
   Timing timing() const override { return Timing::kEveryEpoch; }
   const std::vector<double>& times() const override { return none_; }
   const StillnessConfig* stillness_rule() const override { return &still_rule_; }

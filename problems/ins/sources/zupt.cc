@@ -14,6 +14,7 @@ class ZuptSource : public AidingSource {
   explicit ZuptSource(const ZuptConfig& config) : config_(config) {}
 
   std::vector<std::string> keys() const override { return {kZupt}; }
+  bool noise_estimable() const override { return false; }
   Timing timing() const override { return Timing::kEveryEpoch; }
   const std::vector<double>& times() const override { return none_; }
   const StillnessConfig* stillness_rule() const override { return config_.enabled ? &config_ : nullptr; }
