@@ -38,6 +38,9 @@ DEFINE_double(nhc_sigma_mps, NAN, "Sigma of the non-holonomic constraint, m/s (d
 DEFINE_string(odometer, "", "Wheel-odometer file (t_s,speed_mps or t_s,distance_m): the forward speed of the vehicle reference point, its scale factor estimated (default: the configuration's odometer.file)");
 DEFINE_string(vehicle_mounting_rpy_deg, "", "Roll,pitch,yaw of the IMU (body) axes in the vehicle frame, deg, e.g. 0,0,1.5 (default: the configuration's vehicle.mounting_rpy_deg)");
 DEFINE_string(vehicle_lever_arm_b_m, "", "x,y,z of the vehicle reference point (where NHC holds and the odometer measures) from the IMU, body axes, m (default: the configuration's vehicle.lever_arm_b_m)");
+DEFINE_double(gate_probability, NAN, "Filter: probability of the chi-square gate on each innovation, in (0, 1] (1: no gate; default: the configuration's filter.gate_probability, 0.9999, or 1 for a KF-GINS configuration)");
+DEFINE_bool(variance_components, true, "smooth: estimate each residual group's noise scale in the batch (variance components); false keeps the configured noise");
+DEFINE_bool(strict, false, "Exit with code 3 when the run reports warnings (rejections over 10 %, resets, chi2/dof over 3, inconsistent sigma); the outputs are written either way");
 DEFINE_string(demo_mag, "vector", "smooth --demo: magnetometer use, off|vector|heading|heading_2axis");
 
 namespace navtwin::app {
@@ -145,6 +148,10 @@ std::string CheckFlags(const Options& opt, const Files& files) {
   }
   if (!smooth && !FLAGS_smoother.empty() && FLAGS_smoother != "rts") return "--smoother must be rts (or absent)";
   if (FLAGS_output_rate_hz < 0.0) return "--output_rate_hz must be >= 0";
+  if (FlagGiven("gate_probability") && !(FLAGS_gate_probability > 0.0 && FLAGS_gate_probability <= 1.0)) {
+    return "--gate_probability must be in (0, 1] (1: no gate)";
+  }
+  if (!smooth && FlagGiven("variance_components")) return "--variance_components goes with smooth (the batch)";
   if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
     return "--imu_temperature_degC goes with --calibration";
   }
@@ -196,6 +203,8 @@ std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* confi
     config->start_time_s = FLAGS_start_s;
   }
   if (std::isfinite(FLAGS_end_s)) config->end_time_s = FLAGS_end_s;
+  if (FlagGiven("gate_probability")) config->filter.gate_probability = FLAGS_gate_probability;
+  if (FlagGiven("variance_components")) config->batch.variance_components = FLAGS_variance_components;
   if (FlagGiven("outage_start_s") || FlagGiven("outage_len_s") || FlagGiven("outage_period_s")) {
     config->outages.start_s = FLAGS_outage_start_s;
     config->outages.len_s = FLAGS_outage_len_s;
@@ -254,7 +263,7 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
   } else {
     std::cout << gnss_ins::RunTable(run_options, run);
   }
-  return kExitOk;
+  return FLAGS_strict && !run.warnings.empty() ? kExitWarnings : kExitOk;
 }
 
 const char* const kNavigateUsage =
@@ -262,13 +271,13 @@ const char* const kNavigateUsage =
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
-    "[--format=json]";
+    "[--gate_probability P] [--strict] [--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
-    "[--format=json]\n"
+    "[--gate_probability P] [--variance_components=false] [--strict] [--format=json]\n"
     "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
 
 int RunNavigate(const std::vector<std::string>& args) { return Run({"navigate", kNavigateUsage}, args); }
@@ -283,7 +292,7 @@ Command NavigateCommand() {
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "smoother", "truth",
            "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
            "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps", "odometer", "vehicle_mounting_rpy_deg",
-           "vehicle_lever_arm_b_m"},
+           "vehicle_lever_arm_b_m", "gate_probability", "strict"},
           &RunNavigate};
 }
 
@@ -294,7 +303,8 @@ Command SmoothCommand() {
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "truth", "output_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
            "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps",
-           "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m"},
+           "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m", "gate_probability",
+           "variance_components", "strict"},
           &RunSmooth};
 }
 

@@ -37,5 +37,6 @@ Command CalibrateMagCommand();
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;  ///< bad input data or a failed computation
 constexpr int kExitUsage = 2;    ///< bad command line
+constexpr int kExitWarnings = 3; ///< --strict: the outputs were written, but the run reported warnings
 
 }  // namespace navtwin::app

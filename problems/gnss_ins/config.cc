@@ -623,6 +623,8 @@ GnssInsConfig LoadKfginsConfig(const std::string& path) {
   const double end = root.Double("endtime", -1.0);
   c.end_time_s = end < 0.0 ? kInf : end;  // KF-GINS: -1 = to the end of the IMU file
   if (!(c.end_time_s > c.start_time_s)) root.Fail("endtime", "must be after starttime (or -1)");
+  // KF-GINS uses every fix (no innovation gate): so does the filter, unless --gate_probability.
+  c.filter.gate_probability = 1.0;
 
   // Initial state at starttime, given.
   const Eigen::Vector3d pos = KfVector(root, "initpos", true);  // deg, deg, m

@@ -488,6 +488,14 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
     result.rts = std::move(rts);
   }
   result.filter_covariances = std::move(filter_covariances_);
+  // NIS of the accepted updates per measurement kind (a consistent filter: E[NIS] = dimension).
+  for (const auto& [key, stats] : innovations_) {
+    if (stats.dof == 0) continue;
+    ResidualStats& r = result.filter.residuals[key];
+    r.rows = static_cast<std::size_t>(stats.dof);
+    r.chi2 = stats.nis;
+    r.dof = stats.dof;
+  }
   result.innovations = std::move(innovations_);
   return result;
 }

@@ -16,6 +16,7 @@
 #include "core/sim/simulator.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/densify.h"
+#include "problems/gnss_ins/diagnostics.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/gnss_ins/output.h"
 #include "problems/gnss_ins/sim_config.h"
@@ -193,6 +194,26 @@ void WriteAuxStates(JsonWriter& w, const Solution& solution) {
   w.EndObject();
 }
 
+/// Per residual group: rows, dof, chi2, chi2_per_dof, and for the batch the sigma scale of
+/// the variance components and chi2_per_dof with the configured noise.
+void WriteResiduals(JsonWriter& w, const Solution& solution) {
+  if (solution.residuals.empty()) return;
+  w.Key("residuals").BeginObject();
+  for (const auto& [group, r] : solution.residuals) {
+    w.Key(group)
+        .BeginObject()
+        .Field("rows", r.rows)
+        .Field("dof", r.dof)
+        .Field("chi2", r.chi2)
+        .Field("chi2_per_dof", r.ChiSquarePerDof())
+        .Field("configured_chi2_per_dof", r.configured_chi2_per_dof)
+        .Field("sigma_scale", r.sigma_scale)
+        .Field("adapted", r.adapted)
+        .EndObject();
+  }
+  w.EndObject();
+}
+
 /// One line per auxiliary state: each method's value at the end +- its std.
 void AppendAuxStates(std::string* s, const GnssInsRun& run) {
   if (run.methods.empty()) return;
@@ -244,6 +265,12 @@ void AppendResidualStats(std::string* s, const GnssInsRun& run) {
   }
 }
 
+void AppendWarnings(std::string* s, const GnssInsRun& run) {
+  if (run.warnings.empty()) return;
+  Append(s, "warnings (%zu):\n", run.warnings.size());
+  for (const std::string& w : run.warnings) Append(s, "  %s\n", w.c_str());
+}
+
 }  // namespace
 
 InputSummary SummarizeInputs(const Inputs& inputs) {
@@ -284,6 +311,10 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   RunEstimators(options, config, inputs, &writer, &run);
   run.output_epochs = writer.count();
   if (run.output_epochs == 0) throw std::runtime_error("the run produced no output epoch");
+  run.warnings = Diagnose(run);
+  if (options.progress) {
+    for (const std::string& w : run.warnings) *options.progress << options.command << ": warning: " << w << "\n";
+  }
   run.total_run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // summary.json first (it can still fail), then the solution files.
@@ -317,6 +348,7 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
     }
     w.EndObject();
     WriteAuxStates(w, m.solution);
+    WriteResiduals(w, m.solution);
     if (!m.solution.solver_report.empty()) w.Field("solver_report", m.solution.solver_report);
     if (m.errors) {
       w.Key("errors");
@@ -325,6 +357,9 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
     w.EndObject();
   }
   w.EndObject();
+  w.Key("warnings").BeginArray();
+  for (const std::string& text : run.warnings) w.Value(text);
+  w.EndArray();
   w.Field("total_run_time_s", run.total_run_time_s);
   w.EndObject();
 }
@@ -346,6 +381,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
       Append(&s, "%-7s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
     }
     AppendResidualStats(&s, run);
+    AppendWarnings(&s, run);
     return s;
   }
   const ScoreReport& first = *run.methods.front().errors;
@@ -359,6 +395,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
   AppendAuxStates(&s, run);
   AppendResidualStats(&s, run);
+  AppendWarnings(&s, run);
   return s;
 }
 

@@ -66,6 +66,9 @@ struct GnssInsRun {
   std::size_t output_epochs = 0;
   double output_rate_hz = 0.0;     ///< 0: every IMU epoch
   double total_run_time_s = 0.0;   ///< reading, estimation, scoring and writing
+  /// What went wrong (problems/gnss_ins/diagnostics.h), one sentence each; also printed on
+  /// RunOptions::progress as they are found.
+  std::vector<std::string> warnings;
 };
 
 /// Runs options.methods over the record with `config` and writes the outputs and
