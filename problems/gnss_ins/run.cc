@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <ostream>
 #include <stdexcept>
@@ -31,13 +32,20 @@ MethodRun Scored(const std::string& name, Solution solution, const Scorer& score
   return m;
 }
 
-/// A smoother's knots densified to the output epochs, scored, and written when `writer`.
+/// The callback an estimator's states at every IMU epoch go to: all of them to `scorer`
+/// (when not null), so the score does not depend on the output rate, and the output
+/// epochs (OutputDecimator at config.output_rate_hz) to `writer` (when not null).
+std::function<void(const NavEpoch&)> Feed(TrajectoryScorer* scorer, NavOutputWriter* writer, double output_rate_hz) {
+  return [scorer, writer, decimator = OutputDecimator(output_rate_hz)](const NavEpoch& e) mutable {
+    if (scorer) scorer->Add(e.state.nav);
+    if (writer && decimator.Take(e.state.nav.t_s)) writer->Write(e);
+  };
+}
+
+/// A smoother's knots densified to every IMU epoch, scored, and written when `writer`.
 MethodRun DensifyAndScore(const std::string& name, Solution knots, const Inputs& inputs, double output_rate_hz,
                           Scorer scorer, NavOutputWriter* writer) {
-  Densify(knots, inputs, output_rate_hz, [&](const NavEpoch& e) {
-    if (scorer) scorer->Add(e.state.nav);
-    if (writer) writer->Write(e);
-  });
+  Densify(knots, inputs, Feed(scorer.get(), writer, output_rate_hz));
   return Scored(name, std::move(knots), scorer);
 }
 
@@ -54,13 +62,9 @@ void RunEstimators(const RunOptions& options, const GnssInsConfig& config, const
   // The alignment runs once, before the filter; the batch's prior is the same start.
   const FilterStart start = InitialFilterState(inputs, config, options.progress);
   const Scorer filter_scorer = open_scorer();
-  FilterResult fr = RunFilter(
-      inputs, config, start, run_rts,
-      [&](const NavEpoch& e) {
-        if (filter_scorer) filter_scorer->Add(e.state.nav);
-        if (!run_rts) writer->Write(e);
-      },
-      options.progress);
+  FilterResult fr = RunFilter(inputs, config, start, run_rts,
+                              Feed(filter_scorer.get(), run_rts ? nullptr : writer, config.output_rate_hz),
+                              options.progress);
   run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer));
   run->output_method = "filter";
   if (!run_rts) return;

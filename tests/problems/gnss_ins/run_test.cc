@@ -1,5 +1,6 @@
 // The GNSS/INS run pipeline on a tiny static record: every method computed, scored against
 // the GNSS file, the chosen solution and summary.json written; a failing run leaves nothing.
+// On a short simulated flight: the score does not depend on the output rate.
 #include "problems/gnss_ins/run.h"
 
 #include <dirent.h>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 
 #include "core/earth.h"
 #include "core/io/input_error.h"
+#include "core/io/open.h"
 #include "tests/problems/gnss_ins/static_record.h"
 
 namespace navtwin::gnss_ins {
@@ -50,6 +53,13 @@ Record WriteRecord(const std::string& tag, bool zero_sigma = false) {
   }
   std::ofstream(r.config) << static_record::ConfigYaml();
   return r;
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
 }
 
 RunOptions Options(const Record& r, const std::string& out, RunMethods methods) {
@@ -122,6 +132,94 @@ TEST(GnssInsRun, BadInputLeavesTheFolderEmpty) {
   const std::string out = MakeTempDir("bad_out");
   EXPECT_THROW(RunGnssIns(Options(r, out, RunMethods::kFilterRts), LoadGnssInsConfig(r.config)), InputError);
   EXPECT_TRUE(static_record::Entries(out).empty());
+}
+
+/// 40 s of a tactical-grade IMU at 100 Hz on a flight with wing rock (roll +-15 deg at
+/// 0.4 Hz) and a turn, 1 Hz GNSS, no magnetometer.
+constexpr const char* kWingRockScenario = R"(name: wing-rock-run
+description: 40 s wing rock and a turn, tactical IMU at 100 Hz, 1 Hz GNSS
+start: {lat_deg: 37.0, lon_deg: 127.0, h_m: 500}
+trajectory:
+  initial: {speed_mps: 40, heading_deg: 30}
+  segments:
+    - {kind: cruise, duration_s: 5}
+    - {kind: wing_rock, duration_s: 25, roll_amplitude_deg: 15, roll_frequency_hz: 0.4}
+    - {kind: turn, duration_s: 10, heading_change_deg: 60}
+imu:
+  rate_hz: 100
+  errors:
+    gyro: {bias_deg_h: 10, arw_deg_sqrt_h: 0.1, scale_factor_ppm: 100}
+    accel: {bias_ug: 500, vrw_m_s_sqrt_h: 0.05, scale_factor_ppm: 100}
+gnss: {rate_hz: 1, position_sigma_m: 0.5, velocity_sigma_mps: 0.05}
+)";
+
+/// Compares one statistic of two runs: the scorer saw the same states at every IMU epoch,
+/// so they agree; 1e-9 relative leaves room for a multi-threaded solver's summation order.
+void ExpectSame(double a, double b, const std::string& what) {
+  if (std::isnan(a) && std::isnan(b)) return;
+  EXPECT_NEAR(a, b, 1e-9 * std::max(1.0, std::abs(b))) << what;
+}
+
+// The score of every method is the same at output rate 1 Hz as at every IMU epoch (the
+// scorer sees every IMU epoch either way), while the files hold the decimated epochs, each
+// the same line as in the full-rate file. Scoring the 1 Hz file instead (what the run did
+// before) misses the wing rock between its epochs: its roll RMS is several times larger,
+// so the comparison above can fail.
+TEST(GnssInsRun, ScoresDoNotDependOnTheOutputRate) {
+  const std::string dir = MakeTempDir("rate");
+  const std::string scenario = dir + "/wing_rock.yaml";
+  std::ofstream(scenario) << kWingRockScenario;
+  const DemoFiles sim = SimulateDemo(scenario, 7, "off", dir + "/sim", nullptr);
+  RunOptions options;
+  options.paths.imu = sim.imu;
+  options.paths.gnss = sim.gnss;
+  options.truth = sim.truth;
+  options.config_path = sim.config;
+  options.methods = RunMethods::kAll;
+  GnssInsConfig config = LoadGnssInsConfig(sim.config);
+  config.outages.start_s = 15.0;
+  config.outages.len_s = 10.0;
+  std::vector<GnssInsRun> runs;
+  std::vector<std::string> outs;
+  for (double rate_hz : {0.0, 1.0}) {
+    outs.push_back(MakeTempDir(rate_hz > 0.0 ? "rate_1hz" : "rate_full"));
+    options.out_dir = outs.back();
+    config.output_rate_hz = rate_hz;
+    runs.push_back(RunGnssIns(options, config));
+  }
+  const GnssInsRun& full = runs[0];
+  const GnssInsRun& slow = runs[1];
+  EXPECT_EQ(full.output_epochs, 4000u);
+  EXPECT_EQ(slow.output_epochs, 41u);  // 0.01 s, then 1, 2, ... 40 s
+  ASSERT_EQ(full.methods.size(), 3u);
+  ASSERT_EQ(slow.methods.size(), 3u);
+  for (std::size_t i = 0; i < full.methods.size(); ++i) {
+    const ScoreReport& a = *full.methods[i].errors;
+    const ScoreReport& b = *slow.methods[i].errors;
+    const std::string& name = full.methods[i].name;
+    ASSERT_EQ(a.all.count(), b.all.count()) << name;
+    ASSERT_EQ(a.inside.count(), b.inside.count()) << name;
+    EXPECT_GT(a.inside.count(), 900u) << name;  // truth at 100 Hz over the 10 s outage
+    for (int c = 0; c < 9; ++c) {
+      const std::string what = name + " component " + std::to_string(c);
+      ExpectSame(a.all.Rms(c), b.all.Rms(c), what);
+      ExpectSame(a.inside.Rms(c), b.inside.Rms(c), what + " inside");
+    }
+    ExpectSame(a.outage_horizontal_rms_m, b.outage_horizontal_rms_m, name + " drift");
+  }
+  // The 1 Hz solution file: the full-rate file's lines at the decimated epochs.
+  const std::vector<std::string> full_rows = Lines(outs[0] + "/nav.csv");
+  const std::set<std::string> full_set(full_rows.begin(), full_rows.end());
+  const std::vector<std::string> slow_rows = Lines(outs[1] + "/nav.csv");
+  ASSERT_EQ(slow_rows.size(), 42u);
+  for (const std::string& row : slow_rows) EXPECT_EQ(full_set.count(row), 1u) << row;
+  // Scoring the 1 Hz file itself, as the run did before: the roll RMS is far off.
+  auto old_way = OpenReference(sim.truth, {}, Eigen::Vector3d::Zero());
+  const auto reader = OpenNav(outs[1] + "/nav.nav");
+  NavEpoch e;
+  while (reader->Next(&e.state.nav)) old_way->Add(e.state.nav);
+  const double roll_full = full.methods.back().errors->all.Rms(6);
+  EXPECT_GT(old_way->Report().all.Rms(6), 3.0 * roll_full) << roll_full;
 }
 
 }  // namespace gnss_ins_run_test

@@ -73,10 +73,10 @@ TEST(RtklibWalk, HeadingSearchThenFilterRtsAndBatchBridgeOutages) {
       RunFilter(inputs, config, true, [&](const NavEpoch& e) { filter_score->Add(e.state.nav); }, nullptr);
   ASSERT_TRUE(fr.rts.has_value());
   std::unique_ptr<TrajectoryScorer> rts_score = OpenReference(gnss, inputs.outages, lever);
-  Densify(*fr.rts, inputs, 0.0, [&](const NavEpoch& e) { rts_score->Add(e.state.nav); });
+  Densify(*fr.rts, inputs, [&](const NavEpoch& e) { rts_score->Add(e.state.nav); });
   const Solution batch = RunBatch(inputs, config, *fr.rts, nullptr);
   std::unique_ptr<TrajectoryScorer> batch_score = OpenReference(gnss, inputs.outages, lever);
-  Densify(batch, inputs, 0.0, [&](const NavEpoch& e) { batch_score->Add(e.state.nav); });
+  Densify(batch, inputs, [&](const NavEpoch& e) { batch_score->Add(e.state.nav); });
 
   const Figures f = Summarise(*filter_score);
   const Figures s = Summarise(*rts_score);
