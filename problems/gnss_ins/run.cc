@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
@@ -37,7 +38,7 @@ MethodRun Scored(const std::string& name, Solution solution, const Scorer& score
 /// epochs (OutputDecimator at config.output_rate_hz) to `writer` (when not null).
 std::function<void(const NavEpoch&)> Feed(TrajectoryScorer* scorer, NavOutputWriter* writer, double output_rate_hz) {
   return [scorer, writer, decimator = OutputDecimator(output_rate_hz)](const NavEpoch& e) mutable {
-    if (scorer) scorer->Add(e.state.nav);
+    if (scorer) scorer->Add(e);
     if (writer && decimator.Take(e.state.nav.t_s)) writer->Write(e);
   };
 }
@@ -102,6 +103,43 @@ void WriteStats(JsonWriter& w, const NavErrorStats& s, const ScoreReport& r) {
   w.EndObject();
 }
 
+/// Whether component c (scoring.h order) is compared against this reference.
+bool Compared(const ScoreReport& r, int c) { return c < 3 || (c < 6 ? r.has_velocity : r.has_attitude); }
+
+/// RMS(err/sigma) per compared component, the diagonal position NEES, and per component
+/// the epochs left out for want of a sigma.
+void WriteConsistencyStats(JsonWriter& w, const ConsistencyStats& c, const ScoreReport& r) {
+  static const char* const kKeys[kScoredComponents] = {"pos_n", "pos_e", "pos_d", "vel_n", "vel_e",
+                                                       "vel_d", "roll",  "pitch", "yaw"};
+  w.BeginObject().Field("epochs", c.epochs());
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(r, k)) w.Field(kKeys[k], c.RmsRatio(k));
+  }
+  w.Field("pos_nees_mean", c.PosNeesMean()).Field("pos_nees_epochs", c.nees_count());
+  w.Key("left_out_without_sigma").BeginObject();
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(r, k)) w.Field(kKeys[k], c.missing(k));
+  }
+  w.EndObject().EndObject();
+}
+
+void WriteConsistency(JsonWriter& w, const ScoreReport& r) {
+  w.Key("consistency")
+      .BeginObject()
+      .Field("sigma", r.reference_has_std ? "sqrt(solution^2 + reference^2)" : "solution")
+      .Field("pos_nees", "diagonal sigmas only")
+      .Field("pos_nees_expected", ConsistencyStats::kPosNeesExpected);
+  w.Key("all");
+  WriteConsistencyStats(w, r.consistency_all, r);
+  if (!r.outages.empty()) {
+    w.Key("outside_outages");
+    WriteConsistencyStats(w, r.consistency_outside, r);
+    w.Key("inside_outages");
+    WriteConsistencyStats(w, r.consistency_inside, r);
+  }
+  w.EndObject();
+}
+
 void WriteScore(JsonWriter& w, const ScoreReport& r) {
   w.BeginObject().Field("reference", r.has_attitude ? "navigation" : "gnss");
   w.Key("all");
@@ -125,6 +163,7 @@ void WriteScore(JsonWriter& w, const ScoreReport& r) {
     w.Field("outage_horizontal_rms_m", r.outage_horizontal_rms_m);
     w.Field("outage_vertical_rms_m", r.outage_vertical_rms_m);
   }
+  WriteConsistency(w, r);
   w.EndObject();
 }
 
@@ -180,6 +219,47 @@ void AppendErrorRow(std::string* s, const MethodRun& m, bool outages) {
   cell(r.has_attitude, e.Rms(8) * kRadToDeg);
   if (outages) Append(s, " %10.3f %10.3f", r.outage_horizontal_rms_m, r.outage_vertical_rms_m);
   Append(s, " %10.2f\n", m.solution.run_time_s);
+}
+
+/// One row of the err/sigma table: the compared components' RMS ratios and the NEES.
+void AppendConsistencyRow(std::string* s, const std::string& method, const char* where, const ConsistencyStats& c,
+                          const ScoreReport& r) {
+  Append(s, "%-7s %-8s", method.c_str(), where);
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(r, k)) Append(s, " %6.2f", c.RmsRatio(k));
+  }
+  Append(s, " %8.2f\n", c.PosNeesMean());
+}
+
+/// The err/sigma table (per method over all epochs and, with outages, inside them), and
+/// a line per method whose sigma was missing at some epochs (left out of the ratios).
+void AppendConsistencyTable(std::string* s, const GnssInsRun& run) {
+  const ScoreReport& first = *run.methods.front().errors;
+  const bool outages = !first.outages.empty();
+  Append(s, "err/sigma (RMS; 1 = honest sigma; sigma = %s; NEES: position, diagonal sigmas, expected 3):\n",
+         first.reference_has_std ? "sqrt(solution^2 + reference^2)" : "the solution's");
+  static const char* const kHeads[kScoredComponents] = {"pos N", "pos E", "pos D", "vel N", "vel E",
+                                                        "vel D", "roll",  "pitch", "yaw"};
+  Append(s, "%-7s %-8s", "method", "epochs");
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(first, k)) Append(s, " %6s", kHeads[k]);
+  }
+  Append(s, " %8s\n", "NEES pos");
+  for (const MethodRun& m : run.methods) {
+    AppendConsistencyRow(s, m.name, "all", m.errors->consistency_all, *m.errors);
+    if (outages) AppendConsistencyRow(s, m.name, "outages", m.errors->consistency_inside, *m.errors);
+  }
+  for (const MethodRun& m : run.methods) {
+    const ConsistencyStats& c = m.errors->consistency_all;
+    std::size_t missing = 0;
+    for (int k = 0; k < kScoredComponents; ++k) {
+      if (Compared(*m.errors, k)) missing = std::max(missing, c.missing(k));
+    }
+    if (missing > 0) {
+      Append(s, "%s: no sigma at up to %zu of %zu compared epochs per component (left out of err/sigma)\n",
+             m.name.c_str(), missing, c.epochs());
+    }
+  }
 }
 
 /// The auxiliary states (the aiding sources' parameters) at the end of a solution, with
@@ -326,6 +406,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   if (outages) Append(&s, " %10s %10s", "drift H[m]", "drift V[m]");
   Append(&s, " %10s\n", "run [s]");
   for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
+  AppendConsistencyTable(&s, run);
   AppendAuxStates(&s, run);
   return s;
 }

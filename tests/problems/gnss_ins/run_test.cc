@@ -111,6 +111,8 @@ TEST(GnssInsRun, ComputesScoresAndWritesEveryMethod) {
   const std::string table = RunTable(options, run);
   EXPECT_NE(table.find("errors against " + r.gnss), std::string::npos) << table;
   EXPECT_NE(table.find("\nbatch "), std::string::npos) << table;
+  EXPECT_NE(table.find("err/sigma (RMS; 1 = honest sigma"), std::string::npos) << table;
+  EXPECT_NE(summary.str().find("\"consistency\":{\"sigma\":\"sqrt(solution^2 + reference^2)\""), std::string::npos);
 }
 
 TEST(GnssInsRun, FilterOnlyWithoutTruthWritesTheFilterSolution) {
@@ -200,11 +202,14 @@ TEST(GnssInsRun, ScoresDoNotDependOnTheOutputRate) {
     ASSERT_EQ(a.all.count(), b.all.count()) << name;
     ASSERT_EQ(a.inside.count(), b.inside.count()) << name;
     EXPECT_GT(a.inside.count(), 900u) << name;  // truth at 100 Hz over the 10 s outage
-    for (int c = 0; c < 9; ++c) {
+    for (int c = 0; c < kScoredComponents; ++c) {
       const std::string what = name + " component " + std::to_string(c);
       ExpectSame(a.all.Rms(c), b.all.Rms(c), what);
       ExpectSame(a.inside.Rms(c), b.inside.Rms(c), what + " inside");
+      ExpectSame(a.consistency_all.RmsRatio(c), b.consistency_all.RmsRatio(c), what + " err/sigma");
+      ExpectSame(a.consistency_inside.RmsRatio(c), b.consistency_inside.RmsRatio(c), what + " err/sigma inside");
     }
+    ExpectSame(a.consistency_inside.PosNeesMean(), b.consistency_inside.PosNeesMean(), name + " NEES");
     ExpectSame(a.outage_horizontal_rms_m, b.outage_horizontal_rms_m, name + " drift");
   }
   // The 1 Hz solution file: the full-rate file's lines at the decimated epochs.
@@ -217,7 +222,7 @@ TEST(GnssInsRun, ScoresDoNotDependOnTheOutputRate) {
   auto old_way = OpenReference(sim.truth, {}, Eigen::Vector3d::Zero());
   const auto reader = OpenNav(outs[1] + "/nav.nav");
   NavEpoch e;
-  while (reader->Next(&e.state.nav)) old_way->Add(e.state.nav);
+  while (reader->Next(&e.state.nav)) old_way->Add(e);
   const double roll_full = full.methods.back().errors->all.Rms(6);
   EXPECT_GT(old_way->Report().all.Rms(6), 3.0 * roll_full) << roll_full;
 }
