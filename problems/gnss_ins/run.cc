@@ -11,6 +11,7 @@
 #include <memory>
 #include <ostream>
 #include <stdexcept>
+#include <vector>
 
 #include "core/io/atomic_file.h"
 #include "core/rotation.h"
@@ -26,12 +27,28 @@ namespace navtwin::gnss_ins {
 namespace {
 
 using Scorer = std::unique_ptr<TrajectoryScorer>;
+using ErrorFiles = std::vector<std::unique_ptr<ErrorsCsvWriter>>;
 
-MethodRun Scored(const std::string& name, Solution solution, const Scorer& scorer) {
-  MethodRun m{name, std::move(solution), std::nullopt};
-  if (scorer) m.errors = scorer->Report();
-  return m;
-}
+/// Where the estimators' outputs go: the solution writer (output epochs) and, with a
+/// reference, a scorer per method (every IMU epoch) writing the method's errors.csv.
+struct RunSinks {
+  const RunOptions& options;
+  const GnssInsConfig& config;
+  const Inputs& inputs;
+  NavOutputWriter* writer;
+  ErrorFiles* error_files;  ///< committed by RunGnssIns when the whole run succeeds
+
+  /// A scorer for `method` whose compared epochs go to <out_dir>/<method>/errors.csv;
+  /// null without a reference.
+  Scorer OpenScorer(const std::string& method) const {
+    if (options.truth.empty()) return nullptr;
+    Scorer scorer = OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
+    error_files->push_back(std::make_unique<ErrorsCsvWriter>(options.out_dir, method, scorer->reference_has_std()));
+    ErrorsCsvWriter* csv = error_files->back().get();
+    scorer->OnEpoch([csv](const ScoredEpoch& e) { csv->Write(e); });
+    return scorer;
+  }
+};
 
 /// The callback an estimator's states at every IMU epoch go to: all of them to `scorer`
 /// (when not null), so the score does not depend on the output rate, and the output
@@ -43,43 +60,48 @@ std::function<void(const NavEpoch&)> Feed(TrajectoryScorer* scorer, NavOutputWri
   };
 }
 
-/// A smoother's knots densified to every IMU epoch, scored, and written when `writer`.
-MethodRun DensifyAndScore(const std::string& name, Solution knots, const Inputs& inputs, double output_rate_hz,
-                          Scorer scorer, NavOutputWriter* writer) {
-  Densify(knots, inputs, Feed(scorer.get(), writer, output_rate_hz));
-  return Scored(name, std::move(knots), scorer);
+MethodRun Scored(const std::string& name, Solution solution, const Scorer& scorer, const RunOptions& options) {
+  MethodRun m{name, std::move(solution), std::nullopt, ""};
+  if (scorer) {
+    m.errors = scorer->Report();
+    m.errors_csv = options.out_dir + "/" + name + "/errors.csv";
+  }
+  return m;
 }
 
-/// Filter, then RTS and batch as options.methods asks; the last one goes to `writer`.
-void RunEstimators(const RunOptions& options, const GnssInsConfig& config, const Inputs& inputs,
-                   NavOutputWriter* writer, GnssInsRun* run) {
-  const auto open_scorer = [&]() -> Scorer {
-    if (options.truth.empty()) return nullptr;
-    return OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
-  };
+/// A smoother's knots densified to every IMU epoch, scored, and written when `writer`.
+MethodRun DensifyAndScore(const std::string& name, Solution knots, const RunSinks& sinks, NavOutputWriter* writer) {
+  const Scorer scorer = sinks.OpenScorer(name);
+  Densify(knots, sinks.inputs, Feed(scorer.get(), writer, sinks.config.output_rate_hz));
+  return Scored(name, std::move(knots), scorer, sinks.options);
+}
+
+/// Filter, then RTS and batch as options.methods asks; the last one goes to the writer.
+void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
+  const RunOptions& options = sinks.options;
+  const GnssInsConfig& config = sinks.config;
+  const Inputs& inputs = sinks.inputs;
   const bool run_rts = options.methods != RunMethods::kFilter;
   const bool run_batch = options.methods == RunMethods::kAll;
   if (options.progress) *options.progress << options.command << ": filter" << (run_rts ? " + RTS smoother" : "") << "\n";
   // The alignment runs once, before the filter; the batch's prior is the same start.
   const FilterStart start = InitialFilterState(inputs, config, options.progress);
-  const Scorer filter_scorer = open_scorer();
-  FilterResult fr = RunFilter(inputs, config, start, run_rts,
-                              Feed(filter_scorer.get(), run_rts ? nullptr : writer, config.output_rate_hz),
-                              options.progress);
-  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer));
+  const Scorer filter_scorer = sinks.OpenScorer("filter");
+  FilterResult fr =
+      RunFilter(inputs, config, start, run_rts,
+                Feed(filter_scorer.get(), run_rts ? nullptr : sinks.writer, config.output_rate_hz), options.progress);
+  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer, options));
   run->output_method = "filter";
   if (!run_rts) return;
   if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
-  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), inputs, config.output_rate_hz, open_scorer(),
-                                         run_batch ? nullptr : writer));
+  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), sinks, run_batch ? nullptr : sinks.writer));
   run->output_method = "rts";
   if (!run_batch) return;
   if (options.progress) {
     *options.progress << options.command << ": batch smoother (Ceres) started from the RTS solution\n";
   }
   Solution batch = RunBatch(inputs, config, run->methods.back().solution, &start, options.progress);
-  run->methods.push_back(
-      DensifyAndScore("batch", std::move(batch), inputs, config.output_rate_hz, open_scorer(), writer));
+  run->methods.push_back(DensifyAndScore("batch", std::move(batch), sinks, sinks.writer));
   run->output_method = "batch";
 }
 
@@ -331,17 +353,20 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   run.inputs = SummarizeInputs(inputs);
   run.output_rate_hz = config.output_rate_hz;
   NavOutputWriter writer(options.out_dir, config.filter.scale_factors);
-  RunEstimators(options, config, inputs, &writer, &run);
+  ErrorFiles error_files;
+  RunEstimators(RunSinks{options, config, inputs, &writer, &error_files}, &run);
   run.output_epochs = writer.count();
   if (run.output_epochs == 0) throw std::runtime_error("the run produced no output epoch");
   run.total_run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // summary.json first (it can still fail), then the solution files.
+  // summary.json first (it can still fail), then the per-method errors and the solution.
   const std::string summary = options.out_dir + "/summary.json";
   WriteJsonFile(summary, [&](JsonWriter& w) { WriteRunSummary(w, options, run); });
   try {
+    for (const auto& f : error_files) f->Commit();
     writer.Commit();
   } catch (...) {
+    for (const auto& f : error_files) f->Revoke();
     std::remove(summary.c_str());
     throw;
   }
@@ -371,6 +396,7 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
     if (m.errors) {
       w.Key("errors");
       WriteScore(w, *m.errors);
+      w.Field("errors_csv", m.errors_csv);
     }
     w.EndObject();
   }
@@ -387,9 +413,15 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
          "%.1f .. %.1f s\n",
          options.command.c_str(), in.imu_samples, in.gnss_epochs, in.gnss_removed_by_outages, in.outages.size(),
          in.mag_samples, in.baro_samples, in.t_start_s, in.t_end_s);
-  Append(&s, "solution (%s): %s/{nav.nav, nav.csv, std.csv, imu_errors.csv, summary.json}, %zu epochs\n",
-         run.output_method.c_str(), options.out_dir.c_str(), run.output_epochs);
   const bool scored = !run.methods.empty() && run.methods.front().errors.has_value();
+  Append(&s, "solution (%s): %s/{nav.nav, nav.csv, std.csv, imu_errors.csv, summary.json}, %zu epochs",
+         run.output_method.c_str(), options.out_dir.c_str(), run.output_epochs);
+  if (scored) {
+    std::string names;
+    for (const MethodRun& m : run.methods) names += (names.empty() ? "" : ",") + m.name;
+    Append(&s, "; errors per compared epoch: %s/{%s}/errors.csv", options.out_dir.c_str(), names.c_str());
+  }
+  Append(&s, "\n");
   if (!scored) {
     Append(&s, "%-7s %9s %9s\n", "method", "knots", "run [s]");
     for (const MethodRun& m : run.methods) {

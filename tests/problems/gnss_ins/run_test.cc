@@ -1,6 +1,7 @@
 // The GNSS/INS run pipeline on a tiny static record: every method computed, scored against
-// the GNSS file, the chosen solution and summary.json written; a failing run leaves nothing.
-// On a short simulated flight: the score does not depend on the output rate.
+// the GNSS file, the chosen solution, summary.json and each method's errors.csv written; a
+// failing run leaves nothing. On a short simulated flight: the score does not depend on
+// the output rate.
 #include "problems/gnss_ins/run.h"
 
 #include <dirent.h>
@@ -39,7 +40,9 @@ struct Record {
   std::string dir, imu, gnss, config;
 };
 
-Record WriteRecord(const std::string& tag, bool zero_sigma = false) {
+/// With far_fix, the fix at 15 s is 1 deg (111 km) north: the filter stops there with an
+/// InputError, after the run has begun writing.
+Record WriteRecord(const std::string& tag, bool zero_sigma = false, bool far_fix = false) {
   Record r;
   r.dir = MakeTempDir(tag);
   r.imu = r.dir + "/imu.txt";
@@ -49,7 +52,8 @@ Record WriteRecord(const std::string& tag, bool zero_sigma = false) {
   for (int k = 1; k <= static_record::kImuSamples; ++k) imu << static_record::ImuLine(k);
   std::ofstream gnss(r.gnss);
   for (int t = 0; t <= 20; ++t) {
-    gnss << static_record::GnssLine(t, static_record::kLatDeg, zero_sigma && t == 10 ? "0.0" : "1.0");
+    const double lat_deg = static_record::kLatDeg + (far_fix && t == 15 ? 1.0 : 0.0);
+    gnss << static_record::GnssLine(t, lat_deg, zero_sigma && t == 10 ? "0.0" : "1.0");
   }
   std::ofstream(r.config) << static_record::ConfigYaml();
   return r;
@@ -61,6 +65,14 @@ std::vector<std::string> Lines(const std::string& path) {
   for (std::string l; std::getline(in, l);) lines.push_back(l);
   return lines;
 }
+
+/// errors.csv's header (output.h) and, for a GNSS reference, the reference-sigma columns.
+const char* const kErrorsHeader =
+    "t_s,pos_n_err_m,pos_e_err_m,pos_d_err_m,vel_n_err_mps,vel_e_err_mps,vel_d_err_mps,roll_err_deg,"
+    "pitch_err_deg,yaw_err_deg,pos_n_std_m,pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,vel_d_std_mps,"
+    "roll_std_deg,pitch_std_deg,yaw_std_deg,in_outage";
+const char* const kReferenceStdColumns =
+    ",ref_pos_n_std_m,ref_pos_e_std_m,ref_pos_d_std_m,ref_vel_n_std_mps,ref_vel_e_std_mps,ref_vel_d_std_mps";
 
 RunOptions Options(const Record& r, const std::string& out, RunMethods methods) {
   RunOptions o;
@@ -104,6 +116,18 @@ TEST(GnssInsRun, ComputesScoresAndWritesEveryMethod) {
     std::ifstream f(out + "/" + file);
     EXPECT_TRUE(f.good()) << file;
   }
+  // errors.csv per method: a row per compared reference epoch; the GNSS file's sigmas.
+  for (const MethodRun& m : run.methods) {
+    EXPECT_EQ(m.errors_csv, out + "/" + m.name + "/errors.csv");
+    const std::vector<std::string> rows = Lines(m.errors_csv);
+    ASSERT_FALSE(rows.empty()) << m.name;
+    EXPECT_EQ(rows[0], std::string(kErrorsHeader) + kReferenceStdColumns) << m.name;
+    EXPECT_EQ(rows.size() - 1, m.errors->all.count()) << m.name;
+    EXPECT_EQ(rows.size() - 1, m.errors->consistency_all.epochs()) << m.name;
+    // No velocity and no attitude in this GNSS file: nan; the reference's 1 m north sigma.
+    EXPECT_NE(rows[1].find(",nan,nan,nan,nan,nan,nan,"), std::string::npos) << rows[1];
+    EXPECT_NE(rows[1].find(",0,1,1,2,nan,nan,nan"), std::string::npos) << rows[1];
+  }
   std::stringstream summary;
   summary << std::ifstream(out + "/summary.json").rdbuf();
   EXPECT_NE(summary.str().find("\"output_method\":\"batch\""), std::string::npos) << summary.str();
@@ -111,6 +135,7 @@ TEST(GnssInsRun, ComputesScoresAndWritesEveryMethod) {
   const std::string table = RunTable(options, run);
   EXPECT_NE(table.find("errors against " + r.gnss), std::string::npos) << table;
   EXPECT_NE(table.find("\nbatch "), std::string::npos) << table;
+  EXPECT_NE(table.find(out + "/{filter,rts,batch}/errors.csv"), std::string::npos) << table;
   EXPECT_NE(table.find("err/sigma (RMS; 1 = honest sigma"), std::string::npos) << table;
   EXPECT_NE(summary.str().find("\"consistency\":{\"sigma\":\"sqrt(solution^2 + reference^2)\""), std::string::npos);
 }
@@ -124,6 +149,8 @@ TEST(GnssInsRun, FilterOnlyWithoutTruthWritesTheFilterSolution) {
   ASSERT_EQ(run.methods.size(), 1u);
   EXPECT_EQ(run.output_method, "filter");
   EXPECT_FALSE(run.methods[0].errors.has_value());
+  EXPECT_TRUE(run.methods[0].errors_csv.empty());
+  for (const std::string& entry : static_record::Entries(out)) EXPECT_NE(entry, "filter");  // no errors.csv
   EXPECT_EQ(run.output_epochs, 2000u);  // every IMU epoch
   const std::string table = RunTable(options, run);
   EXPECT_NE(table.find("knots"), std::string::npos) << table;
@@ -134,6 +161,21 @@ TEST(GnssInsRun, BadInputLeavesTheFolderEmpty) {
   const std::string out = MakeTempDir("bad_out");
   EXPECT_THROW(RunGnssIns(Options(r, out, RunMethods::kFilterRts), LoadGnssInsConfig(r.config)), InputError);
   EXPECT_TRUE(static_record::Entries(out).empty());
+}
+
+// A failure in the middle of the filter, after filter/errors.csv was opened: neither the
+// file nor the method folder is left (nor anything else).
+TEST(GnssInsRun, FailureDuringTheRunLeavesNoMethodFolder) {
+  const Record r = WriteRecord("far", /*zero_sigma=*/false, /*far_fix=*/true);
+  const std::string out = MakeTempDir("far_out");
+  EXPECT_THROW(RunGnssIns(Options(r, out, RunMethods::kAll), LoadGnssInsConfig(r.config)), InputError);
+  EXPECT_TRUE(static_record::Entries(out).empty());
+  // The same record without the far fix writes the folder: the check above is not vacuous.
+  const Record good = WriteRecord("near");
+  const std::string out_good = MakeTempDir("near_out");
+  RunGnssIns(Options(good, out_good, RunMethods::kFilter), LoadGnssInsConfig(good.config));
+  // The header and the fixes at 1 .. 20 s (the one at 0 s precedes the first IMU epoch).
+  EXPECT_EQ(Lines(out_good + "/filter/errors.csv").size(), 21u);
 }
 
 /// 40 s of a tactical-grade IMU at 100 Hz on a flight with wing rock (roll +-15 deg at
@@ -211,6 +253,7 @@ TEST(GnssInsRun, ScoresDoNotDependOnTheOutputRate) {
     }
     ExpectSame(a.consistency_inside.PosNeesMean(), b.consistency_inside.PosNeesMean(), name + " NEES");
     ExpectSame(a.outage_horizontal_rms_m, b.outage_horizontal_rms_m, name + " drift");
+    EXPECT_EQ(Lines(full.methods[i].errors_csv).size(), a.all.count() + 1) << name;
   }
   // The 1 Hz solution file: the full-rate file's lines at the decimated epochs.
   const std::vector<std::string> full_rows = Lines(outs[0] + "/nav.csv");
