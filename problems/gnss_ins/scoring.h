@@ -38,6 +38,10 @@
 // (expected value 3; the N-E-D covariances are not kept). An epoch whose sigma of a
 // component is NaN (not computed) or zero is left out of that component and counted as
 // such (ConsistencyStats::missing).
+// Every compared epoch goes to the OnEpoch sink; RunGnssIns writes them to
+// <out_dir>/<method>/errors.csv, one row each: t_s, the nine errors (estimate minus
+// reference; m, m/s, deg), their nine solution sigmas, in_outage, and for a GNSS reference
+// the reference's position and velocity sigmas (layout in output.h, ErrorsCsvWriter).
 #pragma once
 
 #include <array>
