@@ -25,6 +25,7 @@
 #include "core/sim/simulator.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/config.h"
+#include "problems/gnss_ins/densify.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/gnss_ins/inputs.h"
 #include "problems/gnss_ins/output.h"
@@ -103,9 +104,11 @@ void BM_Filter(benchmark::State& state) {
   std::size_t outputs = 0;
   for (auto _ : state) {
     NavOutputWriter writer(out_dir, config.filter.scale_factors);
+    OutputDecimator decimator(config.output_rate_hz);  // as RunGnssIns decimates for its files
     outputs = 0;
     const FilterResult result = RunFilter(inputs, config, /*run_rts=*/false,
                                           [&](const NavEpoch& e) {
+                                            if (!decimator.Take(e.state.nav.t_s)) return;
                                             writer.Write(e);
                                             ++outputs;
                                           },

@@ -13,16 +13,25 @@ namespace {
 /// Times closer than this are the same epoch (knots placed on IMU time tags).
 constexpr double kTimeTol_s = 1e-9;
 
-NavEpoch Blend(const NavEpoch& a, const NavEpoch& b, double w) {
-  NavEpoch e;
-  e.state.imu.bg_radps = (1.0 - w) * a.state.imu.bg_radps + w * b.state.imu.bg_radps;
-  e.state.imu.ba_mps2 = (1.0 - w) * a.state.imu.ba_mps2 + w * b.state.imu.ba_mps2;
-  e.state.imu.sg = (1.0 - w) * a.state.imu.sg + w * b.state.imu.sg;
-  e.state.imu.sa = (1.0 - w) * a.state.imu.sa + w * b.state.imu.sa;
-  if (a.std.size() == b.std.size()) e.std = (1.0 - w) * a.std + w * b.std;
-  if (a.aux.size() == b.aux.size()) e.aux = (1.0 - w) * a.aux + w * b.aux;
-  if (a.aux_std.size() == b.aux_std.size()) e.aux_std = (1.0 - w) * a.aux_std + w * b.aux_std;
-  return e;
+/// (1 - w) a + w b where the sizes agree, else empty; `out` keeps its storage.
+void BlendVector(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double w, Eigen::VectorXd* out) {
+  if (a.size() == b.size()) {
+    *out = (1.0 - w) * a + w * b;
+  } else {
+    out->resize(0);
+  }
+}
+
+/// IMU errors, std and auxiliary states of knots a and b blended at weight w into `e`
+/// (its vectors reused: no allocation per IMU epoch).
+void BlendInto(const NavEpoch& a, const NavEpoch& b, double w, NavEpoch* e) {
+  e->state.imu.bg_radps = (1.0 - w) * a.state.imu.bg_radps + w * b.state.imu.bg_radps;
+  e->state.imu.ba_mps2 = (1.0 - w) * a.state.imu.ba_mps2 + w * b.state.imu.ba_mps2;
+  e->state.imu.sg = (1.0 - w) * a.state.imu.sg + w * b.state.imu.sg;
+  e->state.imu.sa = (1.0 - w) * a.state.imu.sa + w * b.state.imu.sa;
+  BlendVector(a.std, b.std, w, &e->std);
+  BlendVector(a.aux, b.aux, w, &e->aux);
+  BlendVector(a.aux_std, b.aux_std, w, &e->aux_std);
 }
 
 }  // namespace
@@ -39,17 +48,16 @@ bool OutputDecimator::Take(double t_s) {
   return false;
 }
 
-void Densify(const Solution& solution, const Inputs& inputs, double output_rate_hz,
-             const std::function<void(const NavEpoch&)>& output) {
+void Densify(const Solution& solution, const Inputs& inputs, const std::function<void(const NavEpoch&)>& output) {
   const std::vector<NavEpoch>& knots = solution.epochs;
   if (knots.empty()) return;
   const std::size_t n_knots = knots.size();
-  OutputDecimator decimator(output_rate_hz);
   Strapdown mech(knots[0].state.nav);
   std::size_t j = 0;  // mechanizing from knot j
-  // Mechanized states at the output epochs of the current interval, waiting for the
+  // Mechanized states at the IMU epochs of the current interval, waiting for the
   // mismatch at knot j + 1.
   std::vector<NavState> pending;
+  NavEpoch e;  // the epoch handed to `output`, reused
 
   // Knot j + 1 reached with the mechanized state `m`: correct and emit the pending
   // epochs, restart from the knot.
@@ -65,7 +73,7 @@ void Densify(const Solution& solution, const Inputs& inputs, double output_rate_
     const double span = b.state.nav.t_s - a.state.nav.t_s;
     for (const NavState& p : pending) {
       const double w = span > 0.0 ? (p.t_s - a.state.nav.t_s) / span : 1.0;
-      NavEpoch e = Blend(a, b, w);
+      BlendInto(a, b, w, &e);
       e.state.nav = p;
       e.state.nav.lat_rad = p.lat_rad + w * dlat;
       e.state.nav.lon_rad = WrapPi(p.lon_rad + w * dlon);
@@ -97,13 +105,12 @@ void Densify(const Solution& solution, const Inputs& inputs, double output_rate_
       finish_interval(mech.state());
     }
     mech.Update(CorrectImu(piece, knots[j].state.imu));
-    const bool take = decimator.Take(s.t_s);
     if (j + 1 < n_knots) {
-      if (take) pending.push_back(mech.state());
+      pending.push_back(mech.state());
       if (std::abs(s.t_s - knots[j + 1].state.nav.t_s) <= kTimeTol_s) finish_interval(mech.state());
-    } else if (take) {
+    } else {
       // Past the last knot: free mechanization with the last knot's IMU errors and std.
-      NavEpoch e = knots.back();
+      e = knots.back();
       e.state.nav = mech.state();
       output(e);
     }

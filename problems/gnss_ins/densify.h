@@ -1,5 +1,6 @@
 // Dense output from an estimator's sparse states ("knots": the RTS smoother's stored
-// epochs, the batch smoother's parameter epochs), at the IMU epochs or a chosen rate.
+// epochs, the batch smoother's parameter epochs), at every IMU epoch (a writer decimates
+// to the output rate with OutputDecimator, while the scorer sees every epoch).
 //
 // Between knots k and k+1 (times t_k < t_{k+1}) the IMU samples are mechanized from knot k
 // with knot k's IMU-error estimates (CorrectImu), giving x_m(t); at t_{k+1} the mismatch
@@ -34,9 +35,9 @@ class OutputDecimator {
   long long last_tick_ = 0;
 };
 
-/// States at the IMU epochs (decimated to output_rate_hz; 0 = every IMU epoch) from a
-/// smoother's knots (see above). Calls `output` in time order.
-void Densify(const Solution& knots, const Inputs& inputs, double output_rate_hz,
-             const std::function<void(const NavEpoch&)>& output);
+/// States at every IMU epoch after the first knot from a smoother's knots (see above).
+/// Calls `output` in time order; the epoch passed is reused between calls (copy what you
+/// keep).
+void Densify(const Solution& knots, const Inputs& inputs, const std::function<void(const NavEpoch&)>& output);
 
 }  // namespace navtwin::gnss_ins

@@ -21,7 +21,6 @@
 #include "core/strapdown.h"
 #include "factors/attitude_manifold.h"
 #include "factors/position_manifold.h"
-#include "problems/gnss_ins/densify.h"
 #include "problems/gnss_ins/sources.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/ins/measurement_rules.h"
@@ -50,8 +49,7 @@ class NavigationFilter : public ins::FilterAccess {
         start_(start),
         sources_(MakeSources(inputs, config)),
         strapdown_(start.state.nav),
-        imu_(start.state.imu),
-        decimator_(config.output_rate_hz) {
+        imu_(start.state.imu) {
     RegisterSources();
     kf_.emplace(InitialCovariance());
     P_ = kf_->P();
@@ -225,11 +223,15 @@ class NavigationFilter : public ins::FilterAccess {
     }
   }
 
-  /// Output epochs: the rule every method shares (OutputDecimator, densify.h), so the
-  /// filter's, the RTS smoother's and the batch's files have the same epochs.
-  void Output(double t_s) {
-    if (!output_ || !decimator_.Take(t_s)) return;
-    output_(Epoch(Nominal(), aux_, P_));
+  /// The real-time state at every IMU epoch (the caller decimates for its files,
+  /// OutputDecimator in densify.h), built in a reused epoch: no allocation per sample.
+  void Output() {
+    if (!output_) return;
+    output_epoch_.state = Nominal();
+    output_epoch_.aux = aux_;
+    output_epoch_.std = P_.diagonal().head(n_ins_).cwiseMax(0.0).cwiseSqrt();
+    output_epoch_.aux_std = P_.diagonal().tail(n_ - n_ins_).cwiseMax(0.0).cwiseSqrt();
+    output_(output_epoch_);
   }
 
   void Progress(std::size_t k, std::size_t n_imu, double t_s) {
@@ -268,7 +270,7 @@ class NavigationFilter : public ins::FilterAccess {
   std::size_t current_ = 0;           ///< the source being processed
   double epoch_t_s_ = 0.0;
   std::optional<ins::StillnessDetector> detector_;
-  OutputDecimator decimator_;
+  NavEpoch output_epoch_;
   mutable InsState nominal_;
   int progress_step_ = 0;
 
@@ -431,7 +433,7 @@ void NavigationFilter::ProcessImuSample(const ImuSample& sample, const ImuSample
   } else if (next == nullptr || group_dt_ + next->dt_s > cfg_.filter.covariance_interval_s * (1.0 + 1e-9)) {
     FlushGroup();
   }
-  Output(t);
+  Output();
 }
 
 FilterResult NavigationFilter::Run() {

@@ -75,10 +75,11 @@ struct FilterResult {
 };
 
 /// Runs the error-state filter over the inputs (and the RTS smoother when run_rts).
-/// `output` (may be empty) is called with the real-time (causal) state and std at the
-/// output epochs: every IMU epoch, or decimated to config.output_rate_hz (the IMU epoch
-/// nearest each point of the grid k / output_rate_hz); its std comes from the covariance
-/// at the end of the last covariance group (at most covariance_interval_s old).
+/// `output` (may be empty) is called with the real-time (causal) state and std at every
+/// IMU epoch (config.output_rate_hz is the caller's: RunGnssIns decimates for its files
+/// with OutputDecimator, densify.h, and scores every epoch); the epoch passed is reused
+/// between calls (copy what you keep). Its std comes from the covariance at the end of
+/// the last covariance group (at most covariance_interval_s old).
 /// Progress (about every 5 % of the record) on `progress` if not null.
 /// Initialisation per config.init.source (kGiven: config.init.state at its time, IMU
 /// errors from config.init.imu_errors when any is non-zero, else from the state;

@@ -1,7 +1,11 @@
 #include "problems/gnss_ins/output.h"
 
+#include <sys/stat.h>
+
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include "core/io/text_line.h"
 #include "core/rotation.h"
@@ -17,6 +21,15 @@ void Row(std::ostream& out, double t_s, const double* values, int n) {
   line.Number(t_s);
   for (int i = 0; i < n; ++i) line.Char(',').Number(values[i]);
   line.Char('\n').WriteTo(out);
+}
+
+/// A number, or "nan" for any NaN (whatever its sign bit).
+void NumberOrNan(TextLine& line, double x) {
+  if (std::isnan(x)) {
+    line.Char('n').Char('a').Char('n');
+  } else {
+    line.Number(x);
+  }
 }
 
 }  // namespace
@@ -81,6 +94,62 @@ void NavOutputWriter::Commit() {
   csv_.Commit();
   std_.Commit();
   errors_.Commit();
+}
+
+ErrorsCsvWriter::ErrorsCsvWriter(const std::string& out_dir, const std::string& method, bool reference_std)
+    : dir_(out_dir + "/" + method), path_(dir_ + "/errors.csv"), reference_std_(reference_std) {
+  struct stat st;
+  if (::stat(dir_.c_str(), &st) != 0) {
+    if (::mkdir(dir_.c_str(), 0755) != 0) throw std::runtime_error("cannot create the folder " + dir_);
+    created_dir_ = true;
+  } else if (!S_ISDIR(st.st_mode)) {
+    throw std::runtime_error(dir_ + " exists and is not a folder");
+  }
+  try {
+    file_ = std::make_unique<AtomicFile>(path_);
+  } catch (...) {
+    if (created_dir_) ::rmdir(dir_.c_str());
+    throw;
+  }
+  std::ostream& out = file_->stream();
+  out << "t_s,pos_n_err_m,pos_e_err_m,pos_d_err_m,vel_n_err_mps,vel_e_err_mps,vel_d_err_mps,roll_err_deg,"
+         "pitch_err_deg,yaw_err_deg,pos_n_std_m,pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,"
+         "vel_d_std_mps,roll_std_deg,pitch_std_deg,yaw_std_deg,in_outage";
+  if (reference_std_) {
+    out << ",ref_pos_n_std_m,ref_pos_e_std_m,ref_pos_d_std_m,ref_vel_n_std_mps,ref_vel_e_std_mps,ref_vel_d_std_mps";
+  }
+  out << '\n';
+}
+
+ErrorsCsvWriter::~ErrorsCsvWriter() {
+  file_.reset();  // removes the temporary unless committed
+  if (created_dir_ && !committed_) ::rmdir(dir_.c_str());
+}
+
+void ErrorsCsvWriter::Write(const ScoredEpoch& e) {
+  TextLine line;
+  line.Number(e.t_s);
+  for (int c = 0; c < kScoredComponents; ++c) NumberOrNan(line.Char(','), c >= 6 ? e.err[c] * kRadToDeg : e.err[c]);
+  for (int c = 0; c < kScoredComponents; ++c) {
+    NumberOrNan(line.Char(','), c >= 6 ? e.sol_std[c] * kRadToDeg : e.sol_std[c]);
+  }
+  line.Char(',').Char(e.in_outage ? '1' : '0');
+  for (int c = 0; c < 6 && reference_std_; ++c) NumberOrNan(line.Char(','), e.ref_std[c]);
+  line.Char('\n').WriteTo(file_->stream());
+  ++count_;
+}
+
+void ErrorsCsvWriter::Commit() {
+  file_->Commit();
+  committed_ = true;
+}
+
+void ErrorsCsvWriter::Revoke() {
+  if (!committed_) return;
+  std::remove(path_.c_str());
+  if (created_dir_) ::rmdir(dir_.c_str());
+  committed_ = false;
+  created_dir_ = false;
 }
 
 void WriteJsonFile(const std::string& path, const std::function<void(JsonWriter&)>& body) {

@@ -12,17 +12,31 @@
 //   imu_errors.csv  t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg
 //                   [,sg_x_ppm,sg_y_ppm,sg_z_ppm,sa_x_ppm,sa_y_ppm,sa_z_ppm]
 // The bracketed scale-factor columns appear when the writer is built with scale_factors.
+// With a reference (scoring.h), per scored method (filter, rts, batch) in the folder
+// <method>/ (ErrorsCsvWriter), one row per compared reference epoch:
+//   errors.csv      t_s,pos_n_err_m,pos_e_err_m,pos_d_err_m,vel_n_err_mps,vel_e_err_mps,
+//                   vel_d_err_mps,roll_err_deg,pitch_err_deg,yaw_err_deg,pos_n_std_m,
+//                   pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,vel_d_std_mps,
+//                   roll_std_deg,pitch_std_deg,yaw_std_deg,in_outage
+//                   [,ref_pos_n_std_m,ref_pos_e_std_m,ref_pos_d_std_m,ref_vel_n_std_mps,
+//                   ref_vel_e_std_mps,ref_vel_d_std_mps]
+//                   (errors estimate minus reference; *_std the solution's sigmas of
+//                   those errors, ScoredEpoch in scoring.h; in_outage 1 inside an injected
+//                   outage, else 0; the bracketed reference sigmas for a GNSS reference;
+//                   "nan" for components the reference lacks or sigmas not computed)
 // Every file appears whole or not at all (core/io/atomic_file.h): nothing is left in the
 // folder unless Commit() is called.
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
 #include "problems/gnss_ins/ins_vocabulary.h"
+#include "problems/gnss_ins/scoring.h"
 
 namespace navtwin::gnss_ins {
 
@@ -46,6 +60,36 @@ class NavOutputWriter {
   AtomicFile csv_;
   AtomicFile std_;
   AtomicFile errors_;
+};
+
+/// <out_dir>/<method>/errors.csv (layout above). The folder is created when missing and,
+/// like the file, removed again unless Commit() succeeds (a failed run leaves nothing).
+class ErrorsCsvWriter {
+ public:
+  /// reference_std: add the reference-sigma columns (a GNSS reference). Throws
+  /// std::runtime_error when the folder or the file cannot be made.
+  ErrorsCsvWriter(const std::string& out_dir, const std::string& method, bool reference_std);
+  ~ErrorsCsvWriter();
+  ErrorsCsvWriter(const ErrorsCsvWriter&) = delete;
+  ErrorsCsvWriter& operator=(const ErrorsCsvWriter&) = delete;
+
+  void Write(const ScoredEpoch& e);
+  /// Renames the file into place.
+  void Commit();
+  /// Undoes a Commit (a later step of the run failed): removes the file, and the folder
+  /// when this writer created it.
+  void Revoke();
+  std::size_t count() const { return count_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string dir_;
+  std::string path_;
+  bool reference_std_;
+  bool created_dir_ = false;
+  bool committed_ = false;
+  std::size_t count_ = 0;
+  std::unique_ptr<AtomicFile> file_;
 };
 
 /// Writes `path` atomically with one JSON document produced by `body`.

@@ -2,13 +2,16 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <ostream>
 #include <stdexcept>
+#include <vector>
 
 #include "core/io/atomic_file.h"
 #include "core/rotation.h"
@@ -25,57 +28,81 @@ namespace navtwin::gnss_ins {
 namespace {
 
 using Scorer = std::unique_ptr<TrajectoryScorer>;
+using ErrorFiles = std::vector<std::unique_ptr<ErrorsCsvWriter>>;
 
-MethodRun Scored(const std::string& name, Solution solution, const Scorer& scorer) {
-  MethodRun m{name, std::move(solution), std::nullopt};
-  if (scorer) m.errors = scorer->Report();
+/// Where the estimators' outputs go: the solution writer (output epochs) and, with a
+/// reference, a scorer per method (every IMU epoch) writing the method's errors.csv.
+struct RunSinks {
+  const RunOptions& options;
+  const GnssInsConfig& config;
+  const Inputs& inputs;
+  NavOutputWriter* writer;
+  ErrorFiles* error_files;  ///< committed by RunGnssIns when the whole run succeeds
+
+  /// A scorer for `method` whose compared epochs go to <out_dir>/<method>/errors.csv;
+  /// null without a reference.
+  Scorer OpenScorer(const std::string& method) const {
+    if (options.truth.empty()) return nullptr;
+    Scorer scorer = OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
+    error_files->push_back(std::make_unique<ErrorsCsvWriter>(options.out_dir, method, scorer->reference_has_std()));
+    ErrorsCsvWriter* csv = error_files->back().get();
+    scorer->OnEpoch([csv](const ScoredEpoch& e) { csv->Write(e); });
+    return scorer;
+  }
+};
+
+/// The callback an estimator's states at every IMU epoch go to: all of them to `scorer`
+/// (when not null), so the score does not depend on the output rate, and the output
+/// epochs (OutputDecimator at config.output_rate_hz) to `writer` (when not null).
+std::function<void(const NavEpoch&)> Feed(TrajectoryScorer* scorer, NavOutputWriter* writer, double output_rate_hz) {
+  return [scorer, writer, decimator = OutputDecimator(output_rate_hz)](const NavEpoch& e) mutable {
+    if (scorer) scorer->Add(e);
+    if (writer && decimator.Take(e.state.nav.t_s)) writer->Write(e);
+  };
+}
+
+MethodRun Scored(const std::string& name, Solution solution, const Scorer& scorer, const RunOptions& options) {
+  MethodRun m{name, std::move(solution), std::nullopt, ""};
+  if (scorer) {
+    m.errors = scorer->Report();
+    m.errors_csv = options.out_dir + "/" + name + "/errors.csv";
+  }
   return m;
 }
 
-/// A smoother's knots densified to the output epochs, scored, and written when `writer`.
-MethodRun DensifyAndScore(const std::string& name, Solution knots, const Inputs& inputs, double output_rate_hz,
-                          Scorer scorer, NavOutputWriter* writer) {
-  Densify(knots, inputs, output_rate_hz, [&](const NavEpoch& e) {
-    if (scorer) scorer->Add(e.state.nav);
-    if (writer) writer->Write(e);
-  });
-  return Scored(name, std::move(knots), scorer);
+/// A smoother's knots densified to every IMU epoch, scored, and written when `writer`.
+MethodRun DensifyAndScore(const std::string& name, Solution knots, const RunSinks& sinks, NavOutputWriter* writer) {
+  const Scorer scorer = sinks.OpenScorer(name);
+  Densify(knots, sinks.inputs, Feed(scorer.get(), writer, sinks.config.output_rate_hz));
+  return Scored(name, std::move(knots), scorer, sinks.options);
 }
 
-/// Filter, then RTS and batch as options.methods asks; the last one goes to `writer`.
-void RunEstimators(const RunOptions& options, const GnssInsConfig& config, const Inputs& inputs,
-                   NavOutputWriter* writer, GnssInsRun* run) {
-  const auto open_scorer = [&]() -> Scorer {
-    if (options.truth.empty()) return nullptr;
-    return OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
-  };
+/// Filter, then RTS and batch as options.methods asks; the last one goes to the writer.
+void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
+  const RunOptions& options = sinks.options;
+  const GnssInsConfig& config = sinks.config;
+  const Inputs& inputs = sinks.inputs;
   const bool run_rts = options.methods != RunMethods::kFilter;
   const bool run_batch = options.methods == RunMethods::kAll;
   if (options.progress) *options.progress << options.command << ": filter" << (run_rts ? " + RTS smoother" : "") << "\n";
   // The alignment runs once, before the filter; the batch's prior is the same start.
   const FilterStart start = InitialFilterState(inputs, config, options.progress);
-  const Scorer filter_scorer = open_scorer();
-  FilterResult fr = RunFilter(
-      inputs, config, start, run_rts,
-      [&](const NavEpoch& e) {
-        if (filter_scorer) filter_scorer->Add(e.state.nav);
-        if (!run_rts) writer->Write(e);
-      },
-      options.progress);
-  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer));
+  const Scorer filter_scorer = sinks.OpenScorer("filter");
+  FilterResult fr =
+      RunFilter(inputs, config, start, run_rts,
+                Feed(filter_scorer.get(), run_rts ? nullptr : sinks.writer, config.output_rate_hz), options.progress);
+  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer, options));
   run->output_method = "filter";
   if (!run_rts) return;
   if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
-  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), inputs, config.output_rate_hz, open_scorer(),
-                                         run_batch ? nullptr : writer));
+  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), sinks, run_batch ? nullptr : sinks.writer));
   run->output_method = "rts";
   if (!run_batch) return;
   if (options.progress) {
     *options.progress << options.command << ": batch smoother (Ceres) started from the RTS solution\n";
   }
   Solution batch = RunBatch(inputs, config, run->methods.back().solution, &start, options.progress);
-  run->methods.push_back(
-      DensifyAndScore("batch", std::move(batch), inputs, config.output_rate_hz, open_scorer(), writer));
+  run->methods.push_back(DensifyAndScore("batch", std::move(batch), sinks, sinks.writer));
   run->output_method = "batch";
 }
 
@@ -96,6 +123,43 @@ void WriteStats(JsonWriter& w, const NavErrorStats& s, const ScoreReport& r) {
   w.Key("horizontal_m").BeginObject().Field("rms", s.HorizontalRms_m()).Field("max", s.HorizontalMax_m()).EndObject();
   w.Key("vertical_m").BeginObject().Field("rms", s.Rms(2)).Field("max", s.Max(2)).EndObject();
   if (r.has_velocity) w.Field("velocity_rms_mps", VelocityRms_mps(s));
+  w.EndObject();
+}
+
+/// Whether component c (scoring.h order) is compared against this reference.
+bool Compared(const ScoreReport& r, int c) { return c < 3 || (c < 6 ? r.has_velocity : r.has_attitude); }
+
+/// RMS(err/sigma) per compared component, the diagonal position NEES, and per component
+/// the epochs left out for want of a sigma.
+void WriteConsistencyStats(JsonWriter& w, const ConsistencyStats& c, const ScoreReport& r) {
+  static const char* const kKeys[kScoredComponents] = {"pos_n", "pos_e", "pos_d", "vel_n", "vel_e",
+                                                       "vel_d", "roll",  "pitch", "yaw"};
+  w.BeginObject().Field("epochs", c.epochs());
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(r, k)) w.Field(kKeys[k], c.RmsRatio(k));
+  }
+  w.Field("pos_nees_mean", c.PosNeesMean()).Field("pos_nees_epochs", c.nees_count());
+  w.Key("left_out_without_sigma").BeginObject();
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(r, k)) w.Field(kKeys[k], c.missing(k));
+  }
+  w.EndObject().EndObject();
+}
+
+void WriteConsistency(JsonWriter& w, const ScoreReport& r) {
+  w.Key("consistency")
+      .BeginObject()
+      .Field("sigma", r.reference_has_std ? "sqrt(solution^2 + reference^2)" : "solution")
+      .Field("pos_nees", "diagonal sigmas only")
+      .Field("pos_nees_expected", ConsistencyStats::kPosNeesExpected);
+  w.Key("all");
+  WriteConsistencyStats(w, r.consistency_all, r);
+  if (!r.outages.empty()) {
+    w.Key("outside_outages");
+    WriteConsistencyStats(w, r.consistency_outside, r);
+    w.Key("inside_outages");
+    WriteConsistencyStats(w, r.consistency_inside, r);
+  }
   w.EndObject();
 }
 
@@ -122,6 +186,7 @@ void WriteScore(JsonWriter& w, const ScoreReport& r) {
     w.Field("outage_horizontal_rms_m", r.outage_horizontal_rms_m);
     w.Field("outage_vertical_rms_m", r.outage_vertical_rms_m);
   }
+  WriteConsistency(w, r);
   w.EndObject();
 }
 
@@ -177,6 +242,47 @@ void AppendErrorRow(std::string* s, const MethodRun& m, bool outages) {
   cell(r.has_attitude, e.Rms(8) * kRadToDeg);
   if (outages) Append(s, " %10.3f %10.3f", r.outage_horizontal_rms_m, r.outage_vertical_rms_m);
   Append(s, " %10.2f\n", m.solution.run_time_s);
+}
+
+/// One row of the err/sigma table: the compared components' RMS ratios and the NEES.
+void AppendConsistencyRow(std::string* s, const std::string& method, const char* where, const ConsistencyStats& c,
+                          const ScoreReport& r) {
+  Append(s, "%-7s %-8s", method.c_str(), where);
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(r, k)) Append(s, " %6.2f", c.RmsRatio(k));
+  }
+  Append(s, " %8.2f\n", c.PosNeesMean());
+}
+
+/// The err/sigma table (per method over all epochs and, with outages, inside them), and
+/// a line per method whose sigma was missing at some epochs (left out of the ratios).
+void AppendConsistencyTable(std::string* s, const GnssInsRun& run) {
+  const ScoreReport& first = *run.methods.front().errors;
+  const bool outages = !first.outages.empty();
+  Append(s, "err/sigma (RMS; 1 = honest sigma; sigma = %s; NEES: position, diagonal sigmas, expected 3):\n",
+         first.reference_has_std ? "sqrt(solution^2 + reference^2)" : "the solution's");
+  static const char* const kHeads[kScoredComponents] = {"pos N", "pos E", "pos D", "vel N", "vel E",
+                                                        "vel D", "roll",  "pitch", "yaw"};
+  Append(s, "%-7s %-8s", "method", "epochs");
+  for (int k = 0; k < kScoredComponents; ++k) {
+    if (Compared(first, k)) Append(s, " %6s", kHeads[k]);
+  }
+  Append(s, " %8s\n", "NEES pos");
+  for (const MethodRun& m : run.methods) {
+    AppendConsistencyRow(s, m.name, "all", m.errors->consistency_all, *m.errors);
+    if (outages) AppendConsistencyRow(s, m.name, "outages", m.errors->consistency_inside, *m.errors);
+  }
+  for (const MethodRun& m : run.methods) {
+    const ConsistencyStats& c = m.errors->consistency_all;
+    std::size_t missing = 0;
+    for (int k = 0; k < kScoredComponents; ++k) {
+      if (Compared(*m.errors, k)) missing = std::max(missing, c.missing(k));
+    }
+    if (missing > 0) {
+      Append(s, "%s: no sigma at up to %zu of %zu compared epochs per component (left out of err/sigma)\n",
+             m.name.c_str(), missing, c.epochs());
+    }
+  }
 }
 
 /// The auxiliary states (the aiding sources' parameters) at the end of a solution, with
@@ -308,7 +414,8 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   run.inputs = SummarizeInputs(inputs);
   run.output_rate_hz = config.output_rate_hz;
   NavOutputWriter writer(options.out_dir, config.filter.scale_factors);
-  RunEstimators(options, config, inputs, &writer, &run);
+  ErrorFiles error_files;
+  RunEstimators(RunSinks{options, config, inputs, &writer, &error_files}, &run);
   run.output_epochs = writer.count();
   if (run.output_epochs == 0) throw std::runtime_error("the run produced no output epoch");
   run.warnings = Diagnose(run);
@@ -317,12 +424,14 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   }
   run.total_run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // summary.json first (it can still fail), then the solution files.
+  // summary.json first (it can still fail), then the per-method errors and the solution.
   const std::string summary = options.out_dir + "/summary.json";
   WriteJsonFile(summary, [&](JsonWriter& w) { WriteRunSummary(w, options, run); });
   try {
+    for (const auto& f : error_files) f->Commit();
     writer.Commit();
   } catch (...) {
+    for (const auto& f : error_files) f->Revoke();
     std::remove(summary.c_str());
     throw;
   }
@@ -353,6 +462,7 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
     if (m.errors) {
       w.Key("errors");
       WriteScore(w, *m.errors);
+      w.Field("errors_csv", m.errors_csv);
     }
     w.EndObject();
   }
@@ -372,9 +482,15 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
          "%.1f .. %.1f s\n",
          options.command.c_str(), in.imu_samples, in.gnss_epochs, in.gnss_removed_by_outages, in.outages.size(),
          in.mag_samples, in.baro_samples, in.t_start_s, in.t_end_s);
-  Append(&s, "solution (%s): %s/{nav.nav, nav.csv, std.csv, imu_errors.csv, summary.json}, %zu epochs\n",
-         run.output_method.c_str(), options.out_dir.c_str(), run.output_epochs);
   const bool scored = !run.methods.empty() && run.methods.front().errors.has_value();
+  Append(&s, "solution (%s): %s/{nav.nav, nav.csv, std.csv, imu_errors.csv, summary.json}, %zu epochs",
+         run.output_method.c_str(), options.out_dir.c_str(), run.output_epochs);
+  if (scored) {
+    std::string names;
+    for (const MethodRun& m : run.methods) names += (names.empty() ? "" : ",") + m.name;
+    Append(&s, "; errors per compared epoch: %s/{%s}/errors.csv", options.out_dir.c_str(), names.c_str());
+  }
+  Append(&s, "\n");
   if (!scored) {
     Append(&s, "%-7s %9s %9s\n", "method", "knots", "run [s]");
     for (const MethodRun& m : run.methods) {
@@ -393,6 +509,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   if (outages) Append(&s, " %10s %10s", "drift H[m]", "drift V[m]");
   Append(&s, " %10s\n", "run [s]");
   for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
+  AppendConsistencyTable(&s, run);
   AppendAuxStates(&s, run);
   AppendResidualStats(&s, run);
   AppendWarnings(&s, run);

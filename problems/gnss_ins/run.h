@@ -1,8 +1,10 @@
 // One entry point for a GNSS/INS run over a record (docs/gnss-ins.md): read the inputs,
 // run the error-state filter, optionally its RTS smoother and the full-batch smoother,
-// densify each smoother's knots to the output epochs, score every method against a
-// reference when one is given, and write the chosen method's solution (nav.nav, nav.csv,
-// std.csv, imu_errors.csv, output.h) and summary.json into one folder, all or nothing.
+// densify each smoother's knots to every IMU epoch, score every method at every IMU epoch
+// against a reference when one is given (so the score does not depend on the output
+// rate; each method's compared epochs go to <method>/errors.csv), and write the chosen
+// method's solution at the output epochs (nav.nav, nav.csv, std.csv, imu_errors.csv,
+// output.h) and summary.json into one folder, all or nothing.
 // The JSON summary and the table of `navtwin navigate` / `navtwin smooth` come from here.
 #pragma once
 
@@ -55,8 +57,11 @@ InputSummary SummarizeInputs(const Inputs& inputs);
 struct MethodRun {
   std::string name;  ///< "filter", "rts", "batch"
   Solution solution;
-  /// Errors of the method's full-rate output against RunOptions::truth; empty without it.
+  /// Errors of the method's states at every IMU epoch (whatever the output rate) against
+  /// RunOptions::truth; empty without it.
   std::optional<ScoreReport> errors;
+  /// <out_dir>/<name>/errors.csv, the compared epochs (output.h); empty without a reference.
+  std::string errors_csv;
 };
 
 struct GnssInsRun {

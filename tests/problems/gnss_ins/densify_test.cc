@@ -1,5 +1,5 @@
 // Densify: mechanization between knots with the knots' IMU errors, the mismatch spread
-// linearly, knots between IMU epochs, decimation.
+// linearly, knots between IMU epochs, every IMU epoch out; the output decimator.
 #include "problems/gnss_ins/densify.h"
 
 #include <cmath>
@@ -105,9 +105,9 @@ Eigen::Vector3d NedError(const NavState& est, const NavState& truth) {
   return wgs84::GeodeticToNed({est.lat_rad, est.lon_rad, est.h_m}, {truth.lat_rad, truth.lon_rad, truth.h_m});
 }
 
-std::vector<NavEpoch> DensifyAll(const Solution& knots, const Inputs& in, double rate_hz) {
+std::vector<NavEpoch> DensifyAll(const Solution& knots, const Inputs& in) {
   std::vector<NavEpoch> out;
-  Densify(knots, in, rate_hz, [&](const NavEpoch& e) { out.push_back(e); });
+  Densify(knots, in, [&](const NavEpoch& e) { out.push_back(e); });
   return out;
 }
 
@@ -123,7 +123,7 @@ TEST(Densify, ReproducesTheTrajectoryFromConsistentKnots) {
   errors.sa = Eigen::Vector3d(-1e-3, 3e-3, 1e-3);
   const Truth truth = MakeTruth(kKnotTimes);
   ASSERT_EQ(truth.at_knots.size(), kKnotTimes.size());
-  const std::vector<NavEpoch> out = DensifyAll(Knots(truth, errors), ImuInputs(errors), 0.0);
+  const std::vector<NavEpoch> out = DensifyAll(Knots(truth, errors), ImuInputs(errors));
   ASSERT_EQ(out.size(), static_cast<std::size_t>(kSamples));  // every IMU epoch after t = 0
   for (int k = 1; k <= kSamples; ++k) {
     const NavState& e = out[k - 1].state.nav;
@@ -151,7 +151,7 @@ TEST(Densify, SpreadsTheMismatchLinearly) {
   k4.q_n_b = ApplyAttitudeError(phi, k4.q_n_b);
   knots.epochs[3].std.setConstant(1.0);
   knots.epochs[4].std.setConstant(3.0);
-  const std::vector<NavEpoch> out = DensifyAll(knots, ImuInputs(ImuErrors()), 0.0);
+  const std::vector<NavEpoch> out = DensifyAll(knots, ImuInputs(ImuErrors()));
   int checked = 0;
   for (const NavEpoch& e : out) {
     const double t = e.state.nav.t_s;
@@ -173,19 +173,26 @@ TEST(Densify, SpreadsTheMismatchLinearly) {
   EXPECT_EQ(checked, 77);  // IMU epochs 1.24 .. 2.00
 }
 
-// Decimation to 10 Hz: the first epoch, then the first IMU epoch at or after each 0.1 s.
-// After the last knot (5 s) the output continues to the end of the IMU record.
-TEST(Densify, DecimatesAndContinuesAfterTheLastKnot) {
+// Every IMU epoch after the first knot, through the last knot (5 s) to the end of the IMU
+// record; decimated to 10 Hz for a file (OutputDecimator): the first epoch, then the first
+// IMU epoch at or after each 0.1 s.
+TEST(Densify, EveryImuEpochAndContinuesAfterTheLastKnot) {
   const Truth truth = MakeTruth(kKnotTimes);
   Solution knots = Knots(truth, ImuErrors());
   knots.epochs.back().std.setConstant(7.0);
-  const std::vector<NavEpoch> out = DensifyAll(knots, ImuInputs(ImuErrors()), 10.0);
-  ASSERT_EQ(out.size(), 61u);
-  EXPECT_NEAR(out[0].state.nav.t_s, 0.01, 1e-12);
-  for (std::size_t i = 1; i < out.size(); ++i) EXPECT_NEAR(out[i].state.nav.t_s, 0.1 * i, 1e-9) << i;
-  EXPECT_NEAR(out.back().state.nav.t_s, 6.0, 1e-12);
+  const std::vector<NavEpoch> out = DensifyAll(knots, ImuInputs(ImuErrors()));
+  ASSERT_EQ(out.size(), static_cast<std::size_t>(kSamples));
+  for (int k = 1; k <= kSamples; ++k) ASSERT_NEAR(out[k - 1].state.nav.t_s, k * kDt, 1e-12) << k;
   EXPECT_EQ(out.back().std[0], 7.0);
   EXPECT_LT(NedError(out.back().state.nav, truth.at_imu.at(kSamples)).norm(), 1e-6);
+  OutputDecimator decimator(10.0);
+  std::vector<double> taken;
+  for (const NavEpoch& e : out) {
+    if (decimator.Take(e.state.nav.t_s)) taken.push_back(e.state.nav.t_s);
+  }
+  ASSERT_EQ(taken.size(), 61u);
+  EXPECT_NEAR(taken[0], 0.01, 1e-12);
+  for (std::size_t i = 1; i < taken.size(); ++i) EXPECT_NEAR(taken[i], 0.1 * i, 1e-9) << i;
 }
 
 TEST(OutputDecimator, EveryEpochAtRateZero) {

@@ -26,6 +26,7 @@
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
 #include "core/config/yaml_config.h"
+#include "problems/gnss_ins/densify.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/ins/nav_error.h"
 #include "solvers/eskf.h"
@@ -286,21 +287,28 @@ TEST(GnssInsFilter, GnssBetweenImuSamplesIsUsedAtItsOwnTime) {
   }
 }
 
-TEST(GnssInsFilter, OutputDecimationCountsAndProgress) {
+TEST(GnssInsFilter, OutputAtEveryImuEpochCountsAndProgress) {
   const SimRecord& r = PresetRecord("mems-gps-mag-level-flight");
   GnssInsConfig c = MemsConfig(r);
-  c.output_rate_hz = 10.0;
+  c.output_rate_hz = 10.0;  // the caller's to apply: the filter outputs every IMU epoch
   std::vector<double> times;
   std::ostringstream progress;
   const FilterResult result =
       RunFilter(r.inputs, c, false, [&](const NavEpoch& e) { times.push_back(e.state.nav.t_s); }, &progress);
   EXPECT_FALSE(result.rts);
-  // The shared rule (OutputDecimator): the first IMU epoch (0.005 s), then the first IMU
-  // epoch at or after each 0.1 s grid point in (0, 300] s (here exactly on it: 0.1 s is 20
-  // IMU intervals).
-  ASSERT_EQ(times.size(), 3001u);
-  EXPECT_NEAR(times[0], 0.005, 1e-9);
-  for (std::size_t i = 1; i < times.size(); ++i) EXPECT_NEAR(times[i], 0.1 * i, 1e-6);
+  ASSERT_EQ(times.size(), r.inputs.imu.size());
+  for (std::size_t i = 0; i < times.size(); ++i) ASSERT_EQ(times[i], r.inputs.imu[i].t_s) << i;
+  // The shared rule for the files (OutputDecimator): the first IMU epoch (0.005 s), then the
+  // first IMU epoch at or after each 0.1 s grid point in (0, 300] s (here exactly on it:
+  // 0.1 s is 20 IMU intervals).
+  OutputDecimator decimator(c.output_rate_hz);
+  std::vector<double> taken;
+  for (double t : times) {
+    if (decimator.Take(t)) taken.push_back(t);
+  }
+  ASSERT_EQ(taken.size(), 3001u);
+  EXPECT_NEAR(taken[0], 0.005, 1e-9);
+  for (std::size_t i = 1; i < taken.size(); ++i) EXPECT_NEAR(taken[i], 0.1 * i, 1e-6);
   // Progress: 20 lines of 5 % each.
   const std::string p = progress.str();
   EXPECT_EQ(std::count(p.begin(), p.end(), '\n'), 20);

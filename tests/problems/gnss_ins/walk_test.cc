@@ -70,13 +70,13 @@ TEST(RtklibWalk, HeadingSearchThenFilterRtsAndBatchBridgeOutages) {
   const Eigen::Vector3d& lever = config.installation.antenna_lever_arm_b_m;
   std::unique_ptr<TrajectoryScorer> filter_score = OpenReference(gnss, inputs.outages, lever);
   const FilterResult fr =
-      RunFilter(inputs, config, true, [&](const NavEpoch& e) { filter_score->Add(e.state.nav); }, nullptr);
+      RunFilter(inputs, config, true, [&](const NavEpoch& e) { filter_score->Add(e); }, nullptr);
   ASSERT_TRUE(fr.rts.has_value());
   std::unique_ptr<TrajectoryScorer> rts_score = OpenReference(gnss, inputs.outages, lever);
-  Densify(*fr.rts, inputs, 0.0, [&](const NavEpoch& e) { rts_score->Add(e.state.nav); });
+  Densify(*fr.rts, inputs, [&](const NavEpoch& e) { rts_score->Add(e); });
   const Solution batch = RunBatch(inputs, config, *fr.rts, nullptr);
   std::unique_ptr<TrajectoryScorer> batch_score = OpenReference(gnss, inputs.outages, lever);
-  Densify(batch, inputs, 0.0, [&](const NavEpoch& e) { batch_score->Add(e.state.nav); });
+  Densify(batch, inputs, [&](const NavEpoch& e) { batch_score->Add(e); });
 
   const Figures f = Summarise(*filter_score);
   const Figures s = Summarise(*rts_score);
