@@ -46,6 +46,27 @@ void DiagnoseResiduals(const MethodRun& m, std::vector<std::string>* out) {
   }
 }
 
+/// The reference's errors against the reported sigma: inside the injected outages when there
+/// are any (where the reference is independent of the estimator's input), else everywhere.
+void DiagnoseConsistency(const MethodRun& m, std::vector<std::string>* out) {
+  if (!m.errors) return;
+  static const char* const kNames[kScoredComponents] = {"pos N", "pos E", "pos D", "vel N", "vel E",
+                                                        "vel D", "roll",  "pitch", "yaw"};
+  const bool outages = !m.errors->outages.empty();
+  const ConsistencyStats& c = outages ? m.errors->consistency_inside : m.errors->consistency_all;
+  std::string offending;
+  for (int k = 0; k < kScoredComponents; ++k) {
+    const double ratio = c.RmsRatio(k);
+    if (c.count(k) < kWarnMinDof || !(ratio > kWarnSigmaRatio || ratio < 1.0 / kWarnSigmaRatio)) continue;
+    offending += Sentence("%s%s %.2f", offending.empty() ? "" : ", ", kNames[k], ratio);
+  }
+  if (offending.empty()) return;
+  out->push_back(Sentence("%s: sigma inconsistent with the reference%s: RMS err/sigma %s (1 when honest; beyond "
+                          "%.0f or 1/%.0f)",
+                          m.name.c_str(), outages ? " inside the outages" : "", offending.c_str(), kWarnSigmaRatio,
+                          kWarnSigmaRatio));
+}
+
 }  // namespace
 
 std::vector<std::string> Diagnose(const GnssInsRun& run) {
@@ -53,6 +74,7 @@ std::vector<std::string> Diagnose(const GnssInsRun& run) {
   for (const MethodRun& m : run.methods) {
     DiagnoseCounts(m, &out);
     DiagnoseResiduals(m, &out);
+    DiagnoseConsistency(m, &out);
   }
   return out;
 }
