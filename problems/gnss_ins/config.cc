@@ -362,7 +362,8 @@ VehicleConfig ParseVehicle(const ConfigNode& n) {
 
 GnssConfig ParseGnss(const ConfigNode& n) {
   n.RequireKeys({"use_velocity", "pos_std_floor_m", "vel_std_floor_mps", "default_pos_std_m",
-                 "default_vel_std_mps", "max_distance_m"});
+                 "default_vel_std_mps", "max_distance_m", "pos_sigma_scale_h", "pos_sigma_scale_v",
+                 "vel_sigma_scale_h", "vel_sigma_scale_v"});
   GnssConfig x;
   x.use_velocity = n.Bool("use_velocity", x.use_velocity);
   x.pos_std_floor_m = NonNegative(n, "pos_std_floor_m", x.pos_std_floor_m);
@@ -370,6 +371,10 @@ GnssConfig ParseGnss(const ConfigNode& n) {
   x.default_pos_std_m = Sigma(n, "default_pos_std_m", x.default_pos_std_m);
   x.default_vel_std_mps = Sigma(n, "default_vel_std_mps", x.default_vel_std_mps);
   x.max_distance_m = Sigma(n, "max_distance_m", x.max_distance_m);
+  x.pos_sigma_scale_h = Sigma(n, "pos_sigma_scale_h", x.pos_sigma_scale_h);
+  x.pos_sigma_scale_v = Sigma(n, "pos_sigma_scale_v", x.pos_sigma_scale_v);
+  x.vel_sigma_scale_h = Sigma(n, "vel_sigma_scale_h", x.vel_sigma_scale_h);
+  x.vel_sigma_scale_v = Sigma(n, "vel_sigma_scale_v", x.vel_sigma_scale_v);
   return x;
 }
 

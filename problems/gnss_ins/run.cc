@@ -17,6 +17,7 @@
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
+#include "problems/gnss_ins/adapted_noise.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/densify.h"
 #include "problems/gnss_ins/diagnostics.h"
@@ -77,6 +78,24 @@ MethodRun DensifyAndScore(const std::string& name, Solution knots, const RunSink
   return Scored(name, std::move(knots), scorer, sinks.options);
 }
 
+/// With the batch's variance components: the filter and its RTS smoother again with the
+/// noise they found (adapted_noise.h), as methods "filter_adapted" and "rts_adapted".
+void RunAdaptedFilter(const RunSinks& sinks, const FilterStart& start, GnssInsRun* run) {
+  AdaptedNoise adapted = AdaptNoise(sinks.config, run->methods.back().solution.residuals);
+  run->adapted_noise = adapted.lines;
+  if (!adapted.changed) return;
+  const RunOptions& options = sinks.options;
+  if (options.progress) {
+    *options.progress << options.command << ": filter + RTS smoother again with the batch's adapted noise\n";
+  }
+  const Scorer filter_scorer = sinks.OpenScorer("filter_adapted");
+  FilterResult fr = RunFilter(sinks.inputs, adapted.config, start, true,
+                              Feed(filter_scorer.get(), nullptr, adapted.config.output_rate_hz), options.progress);
+  run->methods.push_back(Scored("filter_adapted", std::move(fr.filter), filter_scorer, options));
+  if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
+  run->methods.push_back(DensifyAndScore("rts_adapted", std::move(*fr.rts), sinks, nullptr));
+}
+
 /// Filter, then RTS and batch as options.methods asks; the last one goes to the writer.
 void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
   const RunOptions& options = sinks.options;
@@ -104,6 +123,7 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
   Solution batch = RunBatch(inputs, config, run->methods.back().solution, &start, options.progress);
   run->methods.push_back(DensifyAndScore("batch", std::move(batch), sinks, sinks.writer));
   run->output_method = "batch";
+  RunAdaptedFilter(sinks, start, run);
 }
 
 double VelocityRms_mps(const NavErrorStats& s) {
@@ -233,7 +253,7 @@ void AppendErrorRow(std::string* s, const MethodRun& m, bool outages) {
       Append(s, " %10s", "-");
     }
   };
-  Append(s, "%-7s", m.name.c_str());
+  Append(s, "%-14s", m.name.c_str());
   cell(true, e.HorizontalRms_m());
   cell(true, e.Rms(2));
   cell(r.has_velocity, VelocityRms_mps(e));
@@ -247,7 +267,7 @@ void AppendErrorRow(std::string* s, const MethodRun& m, bool outages) {
 /// One row of the err/sigma table: the compared components' RMS ratios and the NEES.
 void AppendConsistencyRow(std::string* s, const std::string& method, const char* where, const ConsistencyStats& c,
                           const ScoreReport& r) {
-  Append(s, "%-7s %-8s", method.c_str(), where);
+  Append(s, "%-14s %-8s", method.c_str(), where);
   for (int k = 0; k < kScoredComponents; ++k) {
     if (Compared(r, k)) Append(s, " %6.2f", c.RmsRatio(k));
   }
@@ -263,7 +283,7 @@ void AppendConsistencyTable(std::string* s, const GnssInsRun& run) {
          first.reference_has_std ? "sqrt(solution^2 + reference^2)" : "the solution's");
   static const char* const kHeads[kScoredComponents] = {"pos N", "pos E", "pos D", "vel N", "vel E",
                                                         "vel D", "roll",  "pitch", "yaw"};
-  Append(s, "%-7s %-8s", "method", "epochs");
+  Append(s, "%-14s %-8s", "method", "epochs");
   for (int k = 0; k < kScoredComponents; ++k) {
     if (Compared(first, k)) Append(s, " %6s", kHeads[k]);
   }
@@ -348,15 +368,15 @@ void AppendResidualStats(std::string* s, const GnssInsRun& run) {
   for (const MethodRun& m : run.methods) any = any || !m.solution.residuals.empty();
   if (!any) return;
   Append(s, "residuals (whitened; chi2/dof near 1 when the noise fits; batch: sigma scale from variance components):\n");
-  Append(s, "%-7s %-22s %8s %8s %10s %10s %10s %10s\n", "method", "group", "rows", "dof", "rejected", "chi2/dof",
+  Append(s, "%-14s %-22s %8s %8s %10s %10s %10s %10s\n", "method", "group", "rows", "dof", "rejected", "chi2/dof",
          "sigma x", "chi2/dof");
-  Append(s, "%-7s %-22s %8s %8s %10s %10s %10s %10s\n", "", "", "", "", "", "configured", "", "adapted");
+  Append(s, "%-14s %-22s %8s %8s %10s %10s %10s %10s\n", "", "", "", "", "", "configured", "", "adapted");
   for (const MethodRun& m : run.methods) {
     for (const auto& [name, r] : m.solution.residuals) {
       const auto count = m.solution.counts.find(name);
       const std::size_t rejected = count == m.solution.counts.end() ? 0 : count->second.rejected;
       const double configured = std::isnan(r.configured_chi2_per_dof) ? r.ChiSquarePerDof() : r.configured_chi2_per_dof;
-      Append(s, "%-7s %-22s %8zu %8.1f %10zu", m.name.c_str(), name.c_str(), r.rows, r.dof, rejected);
+      Append(s, "%-14s %-22s %8zu %8.1f %10zu", m.name.c_str(), name.c_str(), r.rows, r.dof, rejected);
       if (r.dof >= kMinReportedDof) {
         Append(s, " %10.3f", configured);
       } else {
@@ -369,6 +389,12 @@ void AppendResidualStats(std::string* s, const GnssInsRun& run) {
       }
     }
   }
+}
+
+void AppendAdaptedNoise(std::string* s, const GnssInsRun& run) {
+  if (run.adapted_noise.empty()) return;
+  Append(s, "noise adapted by the batch's variance components (filter_adapted and rts_adapted use it):\n");
+  for (const std::string& line : run.adapted_noise) Append(s, "  %s\n", line.c_str());
 }
 
 void AppendWarnings(std::string* s, const GnssInsRun& run) {
@@ -467,6 +493,9 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
     w.EndObject();
   }
   w.EndObject();
+  w.Key("adapted_noise").BeginArray();
+  for (const std::string& text : run.adapted_noise) w.Value(text);
+  w.EndArray();
   w.Key("warnings").BeginArray();
   for (const std::string& text : run.warnings) w.Value(text);
   w.EndArray();
@@ -492,11 +521,12 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   }
   Append(&s, "\n");
   if (!scored) {
-    Append(&s, "%-7s %9s %9s\n", "method", "knots", "run [s]");
+    Append(&s, "%-14s %9s %9s\n", "method", "knots", "run [s]");
     for (const MethodRun& m : run.methods) {
-      Append(&s, "%-7s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
+      Append(&s, "%-14s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
     }
     AppendResidualStats(&s, run);
+    AppendAdaptedNoise(&s, run);
     AppendWarnings(&s, run);
     return s;
   }
@@ -504,7 +534,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   const bool outages = !first.outages.empty();
   Append(&s, "errors against %s (RMS over %zu reference epochs%s):\n", options.truth.c_str(), first.all.count(),
          outages ? "; drift = per-outage max, RMS over outages" : "");
-  Append(&s, "%-7s %10s %10s %10s %10s %10s %10s", "method", "horiz [m]", "vert [m]", "vel [m/s]", "roll [deg]",
+  Append(&s, "%-14s %10s %10s %10s %10s %10s %10s", "method", "horiz [m]", "vert [m]", "vel [m/s]", "roll [deg]",
          "pitch[deg]", "yaw [deg]");
   if (outages) Append(&s, " %10s %10s", "drift H[m]", "drift V[m]");
   Append(&s, " %10s\n", "run [s]");
@@ -512,6 +542,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   AppendConsistencyTable(&s, run);
   AppendAuxStates(&s, run);
   AppendResidualStats(&s, run);
+  AppendAdaptedNoise(&s, run);
   AppendWarnings(&s, run);
   return s;
 }

@@ -28,7 +28,9 @@ namespace navtwin::gnss_ins {
 enum class RunMethods {
   kFilter,     ///< the filter; its real-time solution is written
   kFilterRts,  ///< filter and RTS smoother; the RTS solution is written
-  kAll,        ///< filter, RTS and the batch smoother (started from RTS); the batch is written
+  kAll,        ///< filter, RTS and the batch smoother (started from RTS); the batch is written;
+               ///< with variance components, then filter and RTS with the adapted noise
+               ///< ("filter_adapted", "rts_adapted", scored but not written)
 };
 
 struct RunOptions {
@@ -74,6 +76,9 @@ struct GnssInsRun {
   /// What went wrong (problems/gnss_ins/diagnostics.h), one sentence each; also printed on
   /// RunOptions::progress as they are found.
   std::vector<std::string> warnings;
+  /// The noise values the batch's variance components changed, one line each ("gyro ARW
+  /// 0.912 -> 2.93 deg/sqrt(h) ..."); empty without adaptation.
+  std::vector<std::string> adapted_noise;
 };
 
 /// Runs options.methods over the record with `config` and writes the outputs and

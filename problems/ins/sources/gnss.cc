@@ -85,10 +85,12 @@ class GnssSource : public AidingSource {
 
  private:
   Eigen::Vector3d PositionSigma(const GnssSample& g) const {
-    return MeasurementSigma(g.pos_std_ned_m, config_.pos_std_floor_m, config_.default_pos_std_m);
+    return MeasurementSigma(g.pos_std_ned_m, config_.pos_std_floor_m, config_.default_pos_std_m)
+        .cwiseProduct(Eigen::Vector3d(config_.pos_sigma_scale_h, config_.pos_sigma_scale_h, config_.pos_sigma_scale_v));
   }
   Eigen::Vector3d VelocitySigma(const GnssSample& g) const {
-    return MeasurementSigma(g.vel_std_ned_mps, config_.vel_std_floor_mps, config_.default_vel_std_mps);
+    return MeasurementSigma(g.vel_std_ned_mps, config_.vel_std_floor_mps, config_.default_vel_std_mps)
+        .cwiseProduct(Eigen::Vector3d(config_.vel_sigma_scale_h, config_.vel_sigma_scale_h, config_.vel_sigma_scale_v));
   }
 
   /// The filter no longer believes the receiver (its covariance is too small for its own

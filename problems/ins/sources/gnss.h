@@ -21,6 +21,13 @@ struct GnssConfig {
   double default_pos_std_m = 5.0;  ///< when the file gives none
   double default_vel_std_mps = 0.1;
   double max_distance_m = 10000.0; ///< a fix this far from the INS prediction is an input error
+  /// Multipliers of the sigmas used (after floor and default), horizontal (N, E) and
+  /// vertical: the noise scales that the batch's variance components estimate
+  /// (ResidualStats::sigma_scale of gnss_position_h, ...), so a run can use them.
+  double pos_sigma_scale_h = 1.0;
+  double pos_sigma_scale_v = 1.0;
+  double vel_sigma_scale_h = 1.0;
+  double vel_sigma_scale_v = 1.0;
 };
 
 /// Counts: "gnss_position", "gnss_velocity", and "gnss_reset" (filter: after

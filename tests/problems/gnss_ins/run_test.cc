@@ -93,10 +93,15 @@ TEST(GnssInsRun, ComputesScoresAndWritesEveryMethod) {
   config.output_rate_hz = 10.0;
   const RunOptions options = Options(r, out, RunMethods::kAll);
   const GnssInsRun run = RunGnssIns(options, config);
-  ASSERT_EQ(run.methods.size(), 3u);
+  // The record's stated sigmas do not fit its noise, so the batch's variance components
+  // adapt it and the filter and RTS run again with the adapted noise.
+  ASSERT_EQ(run.methods.size(), 5u);
   EXPECT_EQ(run.methods[0].name, "filter");
   EXPECT_EQ(run.methods[1].name, "rts");
   EXPECT_EQ(run.methods[2].name, "batch");
+  EXPECT_EQ(run.methods[3].name, "filter_adapted");
+  EXPECT_EQ(run.methods[4].name, "rts_adapted");
+  EXPECT_FALSE(run.adapted_noise.empty());
   EXPECT_EQ(run.output_method, "batch");
   EXPECT_EQ(run.inputs.imu_samples, 2000u);
   EXPECT_EQ(run.inputs.gnss_epochs, 21u);
@@ -135,7 +140,7 @@ TEST(GnssInsRun, ComputesScoresAndWritesEveryMethod) {
   const std::string table = RunTable(options, run);
   EXPECT_NE(table.find("errors against " + r.gnss), std::string::npos) << table;
   EXPECT_NE(table.find("\nbatch "), std::string::npos) << table;
-  EXPECT_NE(table.find(out + "/{filter,rts,batch}/errors.csv"), std::string::npos) << table;
+  EXPECT_NE(table.find(out + "/{filter,rts,batch,filter_adapted,rts_adapted}/errors.csv"), std::string::npos) << table;
   EXPECT_NE(table.find("err/sigma (RMS; 1 = honest sigma"), std::string::npos) << table;
   EXPECT_NE(summary.str().find("\"consistency\":{\"sigma\":\"sqrt(solution^2 + reference^2)\""), std::string::npos);
 }
@@ -235,8 +240,8 @@ TEST(GnssInsRun, ScoresDoNotDependOnTheOutputRate) {
   const GnssInsRun& slow = runs[1];
   EXPECT_EQ(full.output_epochs, 4000u);
   EXPECT_EQ(slow.output_epochs, 41u);  // 0.01 s, then 1, 2, ... 40 s
-  ASSERT_EQ(full.methods.size(), 3u);
-  ASSERT_EQ(slow.methods.size(), 3u);
+  ASSERT_GE(full.methods.size(), 3u);  // filter, rts, batch (and the adapted filter and RTS)
+  ASSERT_EQ(slow.methods.size(), full.methods.size());
   for (std::size_t i = 0; i < full.methods.size(); ++i) {
     const ScoreReport& a = *full.methods[i].errors;
     const ScoreReport& b = *slow.methods[i].errors;
