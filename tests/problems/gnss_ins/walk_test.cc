@@ -2,6 +2,8 @@
 // configuration data/configs/rtklib-walk.yaml (static alignment with a heading search, no
 // heading reference otherwise), 15 s GNSS outages every 45 s from 30 s, scored against the
 // RTK solution (a GNSS reference: the antenna position). Filter, RTS and batch.
+#include <stdlib.h>
+
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -17,6 +19,7 @@
 #include "problems/gnss_ins/densify.h"
 #include "problems/gnss_ins/filter.h"
 #include "problems/gnss_ins/inputs.h"
+#include "problems/gnss_ins/run.h"
 #include "problems/gnss_ins/scoring.h"
 #include "tests/test_data.h"
 
@@ -107,6 +110,58 @@ TEST(RtklibWalk, HeadingSearchThenFilterRtsAndBatchBridgeOutages) {
   EXPECT_LT(b.drift_v_m, 1.0);
   EXPECT_LT(b.outside_h_m, 0.1);
   EXPECT_LT(b.outside_v_m, 0.1);
+}
+
+// The same record through the run the `smooth` command makes, with the default chi-square
+// gate (0.9999): the batch's variance components find the handheld's noise far above the
+// configured one (its unmodelled errors in tight turns), and with it the sigmas inside the
+// outages are honest where they were 1.5 to 8 times too small. The goals: RMS err/sigma of
+// each position axis inside the outages within 0.35-1.5 for the batch and the adapted RTS
+// (measured 0.49-0.79; the upper bound is the issue's, the lower one allows the
+// conservative side by the factor that the 171 correlated epochs of three outages leave
+// uncertain), at most 2 for the adapted filter (measured 0.75-1.12); the adapted filter
+// passes the gate (measured 1 of 328 positions rejected, where the configured noise had 105
+// and 9 resets).
+TEST(RtklibWalk, VarianceComponentsMakeTheSigmasHonestInsideTheOutages) {
+  const std::string imu = DataPath("rtklib-walk/imu_1730.csv");
+  const std::string gnss = DataPath("rtklib-walk/gnss_1730_sf.pos");
+  NAVTWIN_REQUIRE_DATA(imu);
+  NAVTWIN_REQUIRE_DATA(gnss);
+  GnssInsConfig config = LoadGnssInsConfig(std::string(NAVTWIN_SOURCE_DIR) + "/data/configs/rtklib-walk.yaml");
+  config.outages.start_s = 30.0;
+  config.outages.len_s = 15.0;
+  config.outages.period_s = 45.0;
+  config.filter.gate_probability = 0.9999;
+  RunOptions options;
+  options.paths = {imu, gnss, "", "", "", NAN};
+  options.truth = gnss;
+  std::string out = ::testing::TempDir() + "navtwin_walk_XXXXXX";
+  ASSERT_NE(::mkdtemp(out.data()), nullptr);
+  options.out_dir = out;
+  options.command = "smooth";
+  options.methods = RunMethods::kAll;
+  const GnssInsRun run = RunGnssIns(options, config);
+  ASSERT_EQ(run.methods.size(), 5u);
+  for (const MethodRun& m : run.methods) {
+    ASSERT_TRUE(m.errors.has_value());
+    const ConsistencyStats& c = m.errors->consistency_inside;
+    std::cout << m.name << ": err/sigma inside the outages N " << c.RmsRatio(0) << " E " << c.RmsRatio(1) << " D "
+              << c.RmsRatio(2) << ", NEES " << c.PosNeesMean() << "\n";
+    const bool adapted = m.name == "batch" || m.name == "rts_adapted" || m.name == "filter_adapted";
+    if (!adapted) continue;
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LE(c.RmsRatio(k), m.name == "filter_adapted" ? 2.0 : 1.5) << m.name << " axis " << k;
+      EXPECT_GE(c.RmsRatio(k), 0.35) << m.name << " axis " << k;
+    }
+  }
+  const ResidualStats& imu_rows = run.methods[2].solution.residuals.at("imu_velocity_position");
+  EXPECT_TRUE(imu_rows.adapted);
+  EXPECT_GT(imu_rows.sigma_scale, 3.0);  // measured 13.6 over the configured (4 x data sheet) VRW
+  const Solution& adapted_filter = run.methods[3].solution;
+  const MeasurementCount& fixes = adapted_filter.counts.at("gnss_position");
+  EXPECT_LE(fixes.rejected, 7u);  // 2 % of 328
+  EXPECT_EQ(adapted_filter.counts.at("gnss_reset").used, 0u);
+  EXPECT_LT(adapted_filter.residuals.at("gnss_position").ChiSquarePerDof(), 1.5);  // measured 1.05
 }
 
 }  // namespace gnss_ins_walk_test
