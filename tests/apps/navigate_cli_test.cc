@@ -134,6 +134,33 @@ TEST(NavigateCli, WritesTheSolutionAndSummary) {
   EXPECT_TRUE(Exists(out_rts + "/nav.nav"));
 }
 
+// Warnings go to stderr and summary.json with exit code 0; --strict makes them exit code 3,
+// with the files written. Every other fix is 11 m north of the others with a stated 1 m
+// sigma: the gate rejects them (about half of the fixes).
+TEST(NavigateCli, WarningsAndStrict) {
+  std::vector<std::string> jumping;
+  for (int t = 0; t <= 20; ++t) jumping.push_back(GnssLine(t, kLatDeg + (t % 2 == 1 ? 1e-4 : 0.0)));
+  const Record r = WriteRecord("strict", "", 0, 0, 0, jumping);
+  const RunResult plain = Navtwin("navigate " + Args(r, r.dir + "/plain"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.err.find("navigate: warning: filter: gnss_position:"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("rejected by the chi-square gate"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.out.find("warnings ("), std::string::npos) << plain.out;
+  EXPECT_NE(ReadAll(r.dir + "/plain/summary.json").find("\"warnings\":[\"filter: "), std::string::npos);
+  const RunResult strict = Navtwin("navigate " + Args(r, r.dir + "/strict") + " --strict");
+  EXPECT_EQ(strict.exit_code, 3) << strict.err;
+  EXPECT_TRUE(Exists(r.dir + "/strict/nav.nav"));
+  // Without a gate every fix is used: no rejection warning.
+  const RunResult ungated = Navtwin("navigate " + Args(r, r.dir + "/ungated") + " --gate_probability 1");
+  EXPECT_EQ(ungated.err.find("rejected by the chi-square gate"), std::string::npos) << ungated.err;
+  const Record clean_record = WriteRecord("clean");
+  const RunResult clean = Navtwin("navigate " + Args(clean_record, clean_record.dir + "/out") + " --strict");
+  EXPECT_EQ(clean.exit_code, 0) << clean.err << clean.out;
+  EXPECT_EQ(clean.err.find("warning"), std::string::npos) << clean.err;
+  EXPECT_EQ(Navtwin("navigate " + Args(r, r.dir + "/bad") + " --gate_probability 0").exit_code, 2);
+  EXPECT_EQ(Navtwin("navigate " + Args(r, r.dir + "/bad") + " --variance_components=false").exit_code, 2);
+}
+
 // The KF-GINS configuration names the files and the output folder; its units differ
 // (deg/sqrt(h), mGal, hours).
 TEST(NavigateCli, RunsAKfginsConfigurationUnchanged) {
