@@ -50,6 +50,37 @@ std::unique_ptr<MagReader> OpenULogMag(const std::string& path);
 /// it, and temperature; no altitude, which the GNSS/INS inputs take from the pressure).
 std::unique_ptr<BaroReader> OpenULogBaro(const std::string& path);
 
+/// What the PX4 estimate reader did, complete once Next() has returned false.
+struct Px4EstimateStats {
+  std::size_t epochs = 0;             ///< states returned
+  std::size_t invalid = 0;            ///< epochs skipped: a validity flag false
+  std::size_t outside = 0;            ///< epochs outside the velocity or attitude record
+  std::size_t gaps = 0;               ///< epochs skipped: bracketing samples too far apart
+  std::size_t across_reset = 0;       ///< epochs that took the nearer sample across a reset
+  std::string height_field;           ///< "alt_ellipsoid", or "alt" (AMSL)
+  bool ellipsoid = true;              ///< false: heights are AMSL, not WGS84 ellipsoidal
+};
+
+/// PX4's own EKF2 solution as navigation states, at the epochs of vehicle_global_position
+/// (its timestamp_sample: the IMU time the estimate refers to):
+///  - position: lat, lon (deg) and height alt_ellipsoid (WGS84) when the format has it,
+///    else alt (AMSL; Px4EstimateStats says so: heights are then off from WGS84 by the
+///    geoid undulation, tens of metres);
+///  - velocity: vehicle_local_position vx, vy, vz (NED, m/s), linear interpolation;
+///  - attitude: vehicle_attitude q = (w, x, y, z), Hamilton, rotating body FRD into NED
+///    (q_n_b; checked on ekf_failure.ulg against the gyro increments), spherical
+///    interpolation.
+/// Velocity and attitude are interpolated between their two samples around the epoch
+/// (each topic by its timestamp_sample); when the two straddle a reset of that quantity
+/// (vxy/vz_reset_counter, quat_reset_counter) the nearer one is taken instead. An epoch
+/// is skipped (and counted) when lat_lon_valid, alt_valid, v_xy_valid or v_z_valid is
+/// false, when it lies outside the velocity or attitude record, or when the two samples
+/// around it are more than 0.5 s apart. Times through the log's clock (gps_week set).
+class Px4EstimateReader : public NavReader {
+ public:
+  virtual const Px4EstimateStats& stats() const = 0;
+};
+std::unique_ptr<Px4EstimateReader> OpenULogPx4Estimate(const std::string& path);
 /// Every (topic, multi_id) with count, rate, gaps and fields; dropouts and logged
 /// messages in notes.
 FileSummary DescribeULog(const std::string& path);
