@@ -1,5 +1,8 @@
 // End to end on PX4 logs: `navtwin convert --what imu|gnss|mag|baro|px4_estimate` onto GPS
-// time, a log without GPS kept in boot time with a message, misuse.
+// time, a log without GPS kept in boot time with a message, misuse, and `navtwin smooth`
+// with data/configs/px4-multicopter.yaml on ekf_failure.ulg (docs/gnss-ins-results.md).
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -86,6 +89,38 @@ TEST(Px4Cli, MisuseAndWrongKindsLeaveNoOutput) {
   EXPECT_NE(wrong.err.find(dir + "/imu.txt"), std::string::npos) << wrong.err;
   EXPECT_NE(wrong.err.find("px4_estimate"), std::string::npos) << wrong.err;
   EXPECT_FALSE(Exists(dir + "/e.nav"));
+}
+
+// The documented run (docs/gnss-ins-results.md, "Real data: PX4 ekf_failure.ulg"): every
+// method follows the GNSS within its eph/epv class and the run prints the ULog's time scale.
+// Bounds: about twice the measured RMS (filter 0.65 m / 0.83 m / 0.94 m/s, RTS and batch
+// 0.50-0.55 m / 0.47-0.49 m/s), far below the 309 m of a diverging RTS (data-sheet noise).
+TEST(Px4Cli, SmoothsEkfFailureWithTheMulticopterConfiguration) {
+  NAVTWIN_REQUIRE_DATA(EkfFailure());
+  const std::string dir = MakeTempDir("px4");
+  ASSERT_TRUE(ConvertAll(dir));
+  std::ofstream(dir + "/px4-multicopter.yaml")
+      << ReadAll(std::string(NAVTWIN_SOURCE_DIR) + "/data/configs/px4-multicopter.yaml");
+  const std::string files = " --imu " + dir + "/imu.txt --gnss " + dir + "/gnss.txt --mag " + dir + "/mag.csv --baro " +
+                            dir + "/baro.csv --config " + dir + "/px4-multicopter.yaml";
+  const RunResult run = Navtwin("smooth" + files + " --truth " + dir + "/gnss.txt --out " + dir + "/run --format=json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  for (const char* method : {"\"filter\":{", "\"rts\":{", "\"batch\":{"}) {
+    const std::size_t at = run.out.find(method);
+    ASSERT_NE(at, std::string::npos) << method;
+    const std::string m = run.out.substr(at);
+    EXPECT_LT(JsonNumberAfter(m, "\"horizontal_m\"", "rms"), 1.5) << method;
+    EXPECT_LT(JsonNumberAfter(m, "\"vertical_m\"", "rms"), 1.7) << method;
+    EXPECT_LT(JsonNumberAfter(m, "\"velocity_rms_mps\"", "velocity_rms_mps"), 2.0) << method;
+  }
+  // Converted files on GPS time carry no ULog note; the ULog given directly does.
+  EXPECT_EQ(run.err.find("boot time -> GPS"), std::string::npos);
+  const RunResult direct = Navtwin("navigate --imu " + EkfFailure() + " --gnss " + EkfFailure() + " --mag " +
+                                   EkfFailure() + " --baro " + EkfFailure() + " --config " + dir +
+                                   "/px4-multicopter.yaml --out " + dir + "/direct");
+  ASSERT_EQ(direct.exit_code, 0) << direct.err;
+  EXPECT_NE(direct.err.find("navigate: " + EkfFailure() + ": boot time -> GPS week 2353"), std::string::npos)
+      << direct.err;
 }
 
 }  // namespace apps_px4_cli_test
