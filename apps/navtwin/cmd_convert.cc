@@ -1,6 +1,11 @@
 // navtwin convert --in F --out F: reads any supported input and writes the KF-GINS text
-// formats (IMU, GNSS, navigation) or the navtwin IMU CSV. The output appears whole or not
-// at all.
+// formats (IMU, GNSS, navigation), the navtwin IMU CSV, or the navtwin magnetometer and
+// barometer CSV. The output appears whole or not at all.
+//
+// ULog inputs: times are GPS seconds of week when the log has GPS fixes with UTC, else
+// seconds since boot (core/io/ulog_time.h); which one is printed on stderr, and CSV
+// outputs carry it as a '#' note before the header. `--what px4_estimate` (or `nav`)
+// writes PX4's own EKF2 solution as a KF-GINS navigation file (OpenULogPx4Estimate).
 #include <gflags/gflags.h>
 
 #include <iostream>
@@ -8,13 +13,19 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/io/csv_imu.h"
+#include "core/io/csv_mag_baro.h"
+#include "core/io/input_error.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
 #include "core/io/open.h"
+#include "core/io/ulog.h"
+#include "core/io/ulog_time.h"
 
 DEFINE_string(in, "", "Input file (any format `navtwin info` knows)");
-DEFINE_string(what, "", "Stream to convert: imu, gnss or nav (default: the file's main stream)");
-DEFINE_string(to, "", "Output format: kfgins or csv (default: csv for a .csv output, else kfgins)");
+DEFINE_string(what, "",
+              "Stream to convert: imu, gnss, nav, mag, baro or px4_estimate (ULog: PX4's own "
+              "estimate, the same as nav) (default: the file's main stream)");
+DEFINE_string(to, "", "Output format: kfgins or csv (default: csv for a .csv output, else kfgins; mag and baro: csv)");
 
 namespace navtwin::app {
 namespace {
@@ -33,6 +44,10 @@ std::string MainStream(FileFormat f) {
     case FileFormat::kAnsflGt:
     case FileFormat::kAnsflGtExtended:
       return "nav";
+    case FileFormat::kCsvMag:
+      return "mag";
+    case FileFormat::kCsvBaro:
+      return "baro";
     default:
       return "imu";
   }
@@ -55,39 +70,89 @@ int Usage(const std::string& why) {
   return kExitUsage;
 }
 
-int RunConvert(const std::vector<std::string>& args) {
-  if (!args.empty()) return Usage("unexpected argument '" + args[0] + "'");
-  if (FLAGS_in.empty() || FLAGS_out.empty()) return Usage("--in and --out are required");
-  if (FLAGS_in == FLAGS_out) return Usage("--in and --out must differ");
-  const std::string to = !FLAGS_to.empty() ? FLAGS_to : EndsWith(FLAGS_out, ".csv") ? "csv" : "kfgins";
-  if (to != "kfgins" && to != "csv") return Usage("--to must be kfgins or csv");
-  const FileFormat in_format = DetectFormat(FLAGS_in);
-  const std::string what = FLAGS_what.empty() ? MainStream(in_format) : FLAGS_what;
+/// What the run needs to know about the input's time scale.
+struct InputTime {
+  bool ulog = false;
+  ULogClock clock;
+  /// The '#' note for CSV outputs ("" for inputs other than ULog).
+  std::string Note(const std::string& in) const {
+    if (!ulog) return "";
+    return clock.gps ? "t_s: GPS seconds of week " + std::to_string(clock.gps_week) + " (from " +
+                           in + ", " + clock.source + " + " + std::to_string(clock.leap_s) +
+                           " leap seconds)"
+                     : "t_s: seconds since boot of " + in + " (the log has no GPS time)";
+  }
+};
 
-  std::size_t n = 0;
+/// PX4 estimate: what was skipped and which height, on stderr.
+void ReportEstimate(const Px4EstimateStats& st) {
+  std::cerr << "navtwin convert: PX4 estimate: " << st.epochs
+            << " epochs at vehicle_global_position; skipped " << st.invalid << " invalid, "
+            << st.outside << " outside the velocity/attitude record, " << st.gaps
+            << " with a gap over 0.5 s; " << st.across_reset
+            << " took the nearer sample across a reset; height from " << st.height_field
+            << (st.ellipsoid ? " (WGS84 ellipsoid)\n"
+                             : " (AMSL: differs from WGS84 heights by the geoid undulation)\n");
+}
+
+/// Converts one stream; returns the sample count. `to` is checked already.
+std::size_t ConvertStream(const std::string& what, const std::string& to, const InputTime& time) {
+  const std::string note = time.Note(FLAGS_in);
   if (what == "imu") {
     auto reader = OpenImu(FLAGS_in);
     if (to == "csv") {
-      CsvImuWriter writer(FLAGS_out);
-      n = CopyAll(*reader, writer);
-    } else {
-      KfginsImuWriter writer(FLAGS_out);
-      n = CopyAll(*reader, writer);
+      CsvImuWriter writer(FLAGS_out, note);
+      return CopyAll(*reader, writer);
     }
-  } else if (what == "gnss" || what == "nav") {
-    if (to != "kfgins") return Usage("GNSS and navigation streams are written as kfgins only");
-    if (what == "gnss") {
-      auto reader = OpenGnss(FLAGS_in);
-      KfginsGnssWriter writer(FLAGS_out);
-      n = CopyAll(*reader, writer);
-    } else {
-      auto reader = OpenNav(FLAGS_in);
-      KfginsNavWriter writer(FLAGS_out);
-      n = CopyAll(*reader, writer);
-    }
-  } else {
-    return Usage("--what must be imu, gnss or nav");
+    KfginsImuWriter writer(FLAGS_out);
+    return CopyAll(*reader, writer);
   }
+  if (what == "gnss") {
+    auto reader = OpenGnss(FLAGS_in);
+    KfginsGnssWriter writer(FLAGS_out);
+    return CopyAll(*reader, writer);
+  }
+  if (what == "mag") {
+    auto reader = OpenMag(FLAGS_in);
+    CsvMagWriter writer(FLAGS_out, note);
+    return CopyAll(*reader, writer);
+  }
+  if (what == "baro") {
+    auto reader = OpenBaro(FLAGS_in);
+    CsvBaroWriter writer(FLAGS_out, note);
+    return CopyAll(*reader, writer);
+  }
+  if (time.ulog) {  // nav or px4_estimate from a ULog: PX4's own estimate
+    auto reader = OpenULogPx4Estimate(FLAGS_in);
+    KfginsNavWriter writer(FLAGS_out);
+    const std::size_t n = CopyAll(*reader, writer);
+    ReportEstimate(reader->stats());
+    return n;
+  }
+  if (what == "px4_estimate") {
+    throw InputError(FLAGS_in, 0, "px4_estimate",
+                     "PX4's estimate comes from a ULog file (.ulg), not from a file of kind " +
+                         FormatName(DetectFormat(FLAGS_in)));
+  }
+  auto reader = OpenNav(FLAGS_in);
+  KfginsNavWriter writer(FLAGS_out);
+  return CopyAll(*reader, writer);
+}
+
+/// The output format, or "" with *why set when the stream cannot be written so.
+std::string OutputFormat(const std::string& what, std::string* why) {
+  const bool csv_only = what == "mag" || what == "baro";
+  const bool kfgins_only = what == "gnss" || what == "nav" || what == "px4_estimate";
+  std::string to = FLAGS_to;
+  if (to.empty()) to = csv_only || EndsWith(FLAGS_out, ".csv") ? "csv" : "kfgins";
+  if (to != "kfgins" && to != "csv") *why = "--to must be kfgins or csv";
+  if (csv_only && to != "csv") *why = "magnetometer and barometer streams are written as csv only";
+  if (kfgins_only && to != "kfgins") *why = "GNSS and navigation streams are written as kfgins only";
+  return why->empty() ? to : "";
+}
+
+void PrintResult(const std::string& what, const std::string& to, FileFormat in_format,
+                 const InputTime& time, std::size_t n) {
   if (FLAGS_format == "json") {
     JsonWriter w(std::cout);
     w.BeginObject()
@@ -96,21 +161,49 @@ int RunConvert(const std::vector<std::string>& args) {
         .Field("stream", what)
         .Field("out", FLAGS_out)
         .Field("out_format", to)
-        .Field("samples", n)
-        .EndObject();
+        .Field("samples", n);
+    if (time.ulog) {
+      w.Field("time_scale", time.clock.gps ? "gps" : "boot").Field("gps_week", time.clock.gps_week);
+    }
+    w.EndObject();
     std::cout << "\n";
   } else {
     std::cout << "converted " << n << " " << what << " samples from " << FLAGS_in << " ("
               << FormatName(in_format) << ") to " << FLAGS_out << " (" << to << ")\n";
   }
+}
+
+int RunConvert(const std::vector<std::string>& args) {
+  if (!args.empty()) return Usage("unexpected argument '" + args[0] + "'");
+  if (FLAGS_in.empty() || FLAGS_out.empty()) return Usage("--in and --out are required");
+  if (FLAGS_in == FLAGS_out) return Usage("--in and --out must differ");
+  const FileFormat in_format = DetectFormat(FLAGS_in);
+  const std::string what = FLAGS_what.empty() ? MainStream(in_format) : FLAGS_what;
+  if (what != "imu" && what != "gnss" && what != "nav" && what != "mag" && what != "baro" &&
+      what != "px4_estimate") {
+    return Usage("--what must be imu, gnss, nav, mag, baro or px4_estimate");
+  }
+  std::string why;
+  const std::string to = OutputFormat(what, &why);
+  if (!why.empty()) return Usage(why);
+  InputTime time;
+  if (in_format == FileFormat::kULog) {
+    time.ulog = true;
+    time.clock = FindULogClock(FLAGS_in);
+    std::cerr << "navtwin convert: " << FLAGS_in << ": " << time.clock.Describe() << "\n";
+  }
+  const std::size_t n = ConvertStream(what, to, time);
+  PrintResult(what, to, in_format, time, n);
   return kExitOk;
 }
 
 }  // namespace
 
 Command ConvertCommand() {
-  return {"convert", "Convert between formats (ULog, RTKLIB, CSV, drone files -> KF-GINS or CSV)",
-          "navtwin convert --in F --out F [--what imu|gnss|nav] [--to kfgins|csv] [--format=json]",
+  return {"convert",
+          "Convert between formats (ULog, RTKLIB, CSV, drone files -> KF-GINS or CSV; PX4's estimate)",
+          "navtwin convert --in F --out F [--what imu|gnss|nav|mag|baro|px4_estimate] [--to kfgins|csv] "
+          "[--format=json]",
           {"in", "out", "what", "to"},
           &RunConvert};
 }

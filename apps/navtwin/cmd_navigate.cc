@@ -14,6 +14,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,6 +24,8 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/io/json_writer.h"
+#include "core/io/open.h"
+#include "core/io/ulog_time.h"
 #include "core/units.h"
 #include "problems/gnss_ins/run.h"
 
@@ -213,6 +216,17 @@ std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* confi
   return ApplyVehicleFlags(config);
 }
 
+/// For every ULog among the inputs, its time scale (GPS time or boot time) on stderr,
+/// once per file: a log without GPS time cannot be compared with anything on GPS time.
+void ReportULogTimes(const Options& opt, const Files& files) {
+  std::set<std::string> seen;
+  for (const std::string* path : {&files.imu, &files.gnss, &files.mag, &files.baro, &files.truth}) {
+    if (path->empty() || !seen.insert(*path).second) continue;
+    if (DetectFormat(*path) != FileFormat::kULog) continue;
+    std::cerr << opt.command << ": " << *path << ": " << FindULogClock(*path).Describe() << "\n";
+  }
+}
+
 gnss_ins::RunMethods MethodsFromFlags(const Options& opt) {
   if (opt.command == "smooth") return gnss_ins::RunMethods::kAll;
   return FLAGS_smoother == "rts" ? gnss_ins::RunMethods::kFilterRts : gnss_ins::RunMethods::kFilter;
@@ -242,6 +256,7 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
   GnssInsConfig config;
   const std::string config_error = ResolveConfig(opt, &files, &config);
   if (!config_error.empty()) return usage(config_error);
+  ReportULogTimes(opt, files);
   if (!folder) folder = std::make_unique<OutputFolder>(files.out);
   if (!folder->Make()) return usage("cannot create the output folder " + files.out);
 

@@ -59,7 +59,12 @@ namespace navtwin::app {
 
 bool FlagGiven(const char* name) {
   const gflags::CommandLineFlagInfo info = gflags::GetCommandLineFlagInfoOrDie(name);
-  return info.current_value != info.default_value;
+  if (info.current_value != info.default_value) return true;
+  // Set on the command line to its default value (e.g. --variance_components=true over a
+  // configuration that turns it off): gflags marks it modified, so it is not is_default.
+  // An unset flag whose default is NaN is not is_default either (NaN != NaN): its text
+  // equals the default's, "nan".
+  return !info.is_default && info.default_value != "nan";
 }
 
 }  // namespace navtwin::app

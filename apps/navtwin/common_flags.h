@@ -41,8 +41,9 @@ DECLARE_int32(vib_tones);
 
 namespace navtwin::app {
 
-/// Whether a flag was given a value other than its default. Compared as text, because
-/// CommandLineFlagInfo::is_default is false for a NaN default (NaN != NaN).
+/// Whether a flag was given on the command line (also when given its default value, so
+/// that it overrides a configuration file), or otherwise differs from its default.
+/// Unset flags with a NaN default count as not given (compared as text: NaN != NaN).
 bool FlagGiven(const char* name);
 
 }  // namespace navtwin::app

@@ -120,7 +120,8 @@ std::unique_ptr<ImuReader> OpenCsvImu(const std::string& path) {
   return std::make_unique<CsvImuReader>(path);
 }
 
-CsvImuWriter::CsvImuWriter(const std::string& path) : file_(path) {
+CsvImuWriter::CsvImuWriter(const std::string& path, const std::string& note) : file_(path) {
+  if (!note.empty()) file_.stream() << "# " << note << "\n";
   file_.stream() << "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n";
 }
 

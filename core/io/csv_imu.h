@@ -27,7 +27,9 @@ std::unique_ptr<ImuReader> OpenCsvImu(const std::string& path);
 /// Writes the increment form (t_s, dtheta_*_rad, dv_*_mps) with 17 significant digits.
 class CsvImuWriter {
  public:
-  explicit CsvImuWriter(const std::string& path);
+  /// A non-empty note is written as a "# note" line before the header (the readers skip
+  /// it): e.g. the time scale.
+  explicit CsvImuWriter(const std::string& path, const std::string& note = "");
   /// Throws std::invalid_argument on a non-finite value.
   void Write(const ImuSample& sample);
   void Commit();

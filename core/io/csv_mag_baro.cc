@@ -155,7 +155,8 @@ std::unique_ptr<BaroReader> OpenCsvBaro(const std::string& path) {
   return std::make_unique<CsvBaroReader>(path);
 }
 
-CsvMagWriter::CsvMagWriter(const std::string& path) : file_(path) {
+CsvMagWriter::CsvMagWriter(const std::string& path, const std::string& note) : file_(path) {
+  if (!note.empty()) file_.stream() << "# " << note << "\n";
   file_.stream() << "t_s,mx_uT,my_uT,mz_uT\n";
 }
 
@@ -169,7 +170,8 @@ void CsvMagWriter::Write(const MagSample& s) {
 
 void CsvMagWriter::Commit() { file_.Commit(); }
 
-CsvBaroWriter::CsvBaroWriter(const std::string& path) : file_(path) {
+CsvBaroWriter::CsvBaroWriter(const std::string& path, const std::string& note) : file_(path) {
+  if (!note.empty()) file_.stream() << "# " << note << "\n";
   file_.stream() << "t_s,pressure_pa,altitude_m,temperature_degC\n";
 }
 

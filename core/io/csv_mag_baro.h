@@ -31,7 +31,9 @@ std::unique_ptr<BaroReader> OpenCsvBaro(const std::string& path);
 /// Writes t_s,mx_uT,my_uT,mz_uT with 17 significant digits; the file appears on Commit().
 class CsvMagWriter {
  public:
-  explicit CsvMagWriter(const std::string& path);
+  /// A non-empty note is written as a "# note" line before the header (the readers skip
+  /// it): e.g. the time scale.
+  explicit CsvMagWriter(const std::string& path, const std::string& note = "");
   /// Throws std::invalid_argument on a non-finite value.
   void Write(const MagSample& sample);
   void Commit();
@@ -44,7 +46,9 @@ class CsvMagWriter {
 /// an empty field; the file appears on Commit().
 class CsvBaroWriter {
  public:
-  explicit CsvBaroWriter(const std::string& path);
+  /// A non-empty note is written as a "# note" line before the header (the readers skip
+  /// it): e.g. the time scale.
+  explicit CsvBaroWriter(const std::string& path, const std::string& note = "");
   /// Throws std::invalid_argument for a non-finite time, an infinite value, or a sample
   /// with neither pressure nor altitude.
   void Write(const BaroSample& sample);

@@ -248,6 +248,8 @@ std::unique_ptr<NavReader> OpenNav(const std::string& path) {
       return OpenAnsflGt(path);
     case FileFormat::kAnsflGtExtended:
       return OpenAnsflGtExtended(path);
+    case FileFormat::kULog:
+      return OpenULogPx4Estimate(path);
     default:
       Refuse(path, "navigation states", format);
   }

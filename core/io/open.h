@@ -46,6 +46,8 @@ std::string FormatName(FileFormat format);
 /// holds no such stream (and for unknown files).
 std::unique_ptr<ImuReader> OpenImu(const std::string& path);
 std::unique_ptr<GnssReader> OpenGnss(const std::string& path);
+/// Navigation: KF-GINS, the ANSFL ground truth, and ULog (PX4's own estimate,
+/// OpenULogPx4Estimate).
 std::unique_ptr<NavReader> OpenNav(const std::string& path);
 /// navtwin CSV magnetometer files, raw Xsens DOT files with Mag columns, and ULog.
 std::unique_ptr<MagReader> OpenMag(const std::string& path);

@@ -9,6 +9,8 @@
 
 #include "core/io/input_error.h"
 #include "core/io/ulog_format.h"
+#include "core/io/ulog_time.h"
+#include "core/io/ulog_topic.h"
 #include "core/rotation.h"
 #include "core/units.h"
 
@@ -17,9 +19,6 @@ namespace {
 
 using ulog::BaseType;
 
-constexpr double kMinFixType = 3;  // PX4 fix_type: 0-1 none, 2 2D, 3 3D, 4+ DGPS/RTK
-// PX4's marker for "no sample" in *_timestamp_relative fields (INT32_MAX).
-constexpr double kRelativeTimestampInvalid = 2147483647.0;
 // Flag bits ('B'): incompat_flags[0] bit 0 = data appended; other bits are unknown to us.
 constexpr std::uint8_t kIncompatDataAppended = 0x01;
 constexpr std::size_t kFlagBitsSize = 40;  // compat[8], incompat[8], appended_offsets[3]
@@ -29,19 +28,6 @@ std::string CString(const std::uint8_t* p, std::size_t n) {
   std::size_t len = 0;
   while (len < n && p[len] != 0) ++len;
   return std::string(reinterpret_cast<const char*>(p), len);
-}
-
-std::string FormatNumber(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.9g", v);
-  return text;
-}
-
-bool SubscriptionHasField(const ULogSubscription& sub, const std::string& field) {
-  for (const ULogField& f : sub.fields) {
-    if (f.name == field) return true;
-  }
-  return false;
 }
 
 }  // namespace
@@ -218,7 +204,7 @@ std::string ULogFile::Impl::ValueText(const ulog::TypedName& key, std::size_t va
   std::string text;
   for (std::size_t i = 0; i < count; ++i) {
     if (i > 0) text += ",";
-    text += FormatNumber(ulog::DecodeAsDouble(type, value + i * ulog::BaseTypeSize(type)));
+    text += ulog::FormatNumber(ulog::DecodeAsDouble(type, value + i * ulog::BaseTypeSize(type)));
   }
   return text;
 }
@@ -397,6 +383,7 @@ std::string ULogFile::GetString(const std::string& field) const {
 
 const std::string& ULogFile::path() const { return impl_->stream_.path(); }
 int ULogFile::version() const { return impl_->stream_.version(); }
+std::uint64_t ULogFile::start_time_us() const { return impl_->stream_.start_time_us(); }
 const std::map<std::string, std::string>& ULogFile::info() const { return impl_->info_; }
 const std::map<std::string, double>& ULogFile::parameters() const { return impl_->parameters_; }
 const std::vector<ULogSubscription>& ULogFile::subscriptions() const {
@@ -419,288 +406,8 @@ std::vector<ULogSubscription> ListULogSubscriptions(const std::string& path) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Typed readers.
+// DescribeULog.
 namespace {
-
-// A topic a typed reader can take its samples from, in order of preference.
-struct Candidate {
-  const char* topic;
-  const char* needed_field;         // the candidate counts only if it has this field
-  const char* relative_time_field;  // "" or a *_timestamp_relative field (old sensor_combined)
-};
-
-// The subscription (instance 0) that matches a candidate, or nullptr.
-const ULogSubscription* FindSubscription(const std::vector<ULogSubscription>& subs,
-                                         const Candidate& candidate) {
-  for (const ULogSubscription& sub : subs) {
-    if (sub.topic == candidate.topic && sub.multi_id == 0 &&
-        SubscriptionHasField(sub, candidate.needed_field)) {
-      return &sub;
-    }
-  }
-  return nullptr;
-}
-
-// The first candidate subscribed in the file; InputError if none is.
-Candidate ChooseTopic(const std::string& path, const std::vector<Candidate>& candidates,
-                      const std::string& what) {
-  const std::vector<ULogSubscription> subs = ListULogSubscriptions(path);
-  std::string names;
-  for (const Candidate& c : candidates) {
-    if (FindSubscription(subs, c) != nullptr) return c;
-    names += (names.empty() ? "" : " or ") + std::string(c.topic) + "." + c.needed_field;
-  }
-  throw InputError(path, 0, what, "no " + names + " in this log");
-}
-
-// One topic instance in time order. Repeated times are skipped (real logs repeat a
-// sample now and then); a time that goes backwards is an InputError at its byte offset.
-class TimeOrderedTopic {
- public:
-  TimeOrderedTopic(const std::string& path, const Candidate& source)
-      : log_(path), topic_(source.topic), relative_field_(source.relative_time_field) {}
-
-  bool Next() {
-    while (log_.NextOf(topic_)) {
-      std::int64_t t_us = static_cast<std::int64_t>(log_.timestamp_us());
-      if (!relative_field_.empty()) {
-        const double relative_us = log_.GetDouble(relative_field_);
-        if (relative_us == kRelativeTimestampInvalid) continue;  // no new sample of this sensor
-        t_us += static_cast<std::int64_t>(relative_us);
-      }
-      if (has_time_ && t_us == time_us_) continue;
-      if (has_time_ && t_us < time_us_) {
-        throw InputError::AtByte(
-            log_.path(), log_.byte_offset(),
-            topic_ + "." + (relative_field_.empty() ? "timestamp" : relative_field_),
-            "time goes backwards: " + std::to_string(t_us) + " us after " +
-                std::to_string(time_us_) + " us");
-      }
-      has_previous_ = has_time_;
-      previous_us_ = time_us_;
-      time_us_ = t_us;
-      has_time_ = true;
-      return true;
-    }
-    return false;
-  }
-
-  const ULogFile& log() const { return log_; }
-  const std::string& topic() const { return topic_; }
-  double t_s() const { return static_cast<double>(time_us_) * kMicrosecond_s; }
-  bool has_previous() const { return has_previous_; }
-  double dt_s() const { return static_cast<double>(time_us_ - previous_us_) * kMicrosecond_s; }
-
-  /// A finite field value; InputError naming the field otherwise.
-  double Finite(const std::string& field, int index = -1) const {
-    const double v = index < 0 ? log_.GetDouble(field) : log_.GetArray(field, index);
-    if (!std::isfinite(v)) {
-      throw InputError::AtByte(log_.path(), log_.byte_offset(), topic_ + "." + field, "not finite");
-    }
-    return v;
-  }
-  /// As Finite(), NaN when the format has no such field.
-  double FiniteOrNaN(const std::string& field) const {
-    return log_.HasField(field) ? Finite(field) : std::numeric_limits<double>::quiet_NaN();
-  }
-  Eigen::Vector3d Vector(const std::string& field) const {
-    return {Finite(field, 0), Finite(field, 1), Finite(field, 2)};
-  }
-  /// A standard deviation, which must be positive and finite.
-  double Sigma(const std::string& field) const {
-    const double v = Finite(field);
-    if (v <= 0.0) {
-      throw InputError::AtByte(log_.path(), log_.byte_offset(), topic_ + "." + field,
-                               "standard deviation must be positive, got " + FormatNumber(v));
-    }
-    return v;
-  }
-
- private:
-  ULogFile log_;
-  std::string topic_;
-  std::string relative_field_;
-  bool has_time_ = false;
-  bool has_previous_ = false;
-  std::int64_t time_us_ = 0;
-  std::int64_t previous_us_ = 0;
-};
-
-class ULogImuReader final : public ImuReader {
- public:
-  explicit ULogImuReader(const std::string& path)
-      : path_(path),
-        topic_(path, ChooseTopic(path, {{"sensor_combined", "gyro_rad", ""}}, "imu")) {}
-
-  bool Next(ImuSample* sample) override {
-    while (topic_.Next()) {
-      const double gyro_dt_s = IntegralSeconds("gyro_integral_dt");
-      const double accel_dt_s = IntegralSeconds("accelerometer_integral_dt");
-      double dt_s = gyro_dt_s;
-      if (topic_.has_previous()) {
-        dt_s = topic_.dt_s();
-      } else if (gyro_dt_s <= 0.0) {
-        continue;  // no interval for the first sample: it only starts the clock
-      }
-      sample->t_s = topic_.t_s();
-      sample->dt_s = dt_s;
-      // The rates are averages over the integration time; without one, over dt_s.
-      sample->dtheta_b_rad = topic_.Vector("gyro_rad") * (gyro_dt_s > 0.0 ? gyro_dt_s : dt_s);
-      sample->dv_b_mps =
-          topic_.Vector("accelerometer_m_s2") * (accel_dt_s > 0.0 ? accel_dt_s : dt_s);
-      return true;
-    }
-    return false;
-  }
-  const std::string& path() const override { return path_; }
-
- private:
-  // Integration time in seconds: integers are microseconds, floats seconds (old PX4);
-  // 0 when the field is absent.
-  double IntegralSeconds(const std::string& field) const {
-    if (!topic_.log().HasField(field)) return 0.0;
-    const double v = topic_.Finite(field);
-    if (v < 0.0) {
-      throw InputError::AtByte(path_, topic_.log().byte_offset(), "sensor_combined." + field,
-                               "negative integration time");
-    }
-    const std::string type = topic_.log().FieldType(field);
-    return type == "float" || type == "double" ? v : v * kMicrosecond_s;
-  }
-
-  std::string path_;
-  TimeOrderedTopic topic_;
-};
-
-// Position field names and scales of a GNSS topic: new float names (deg, m) or old
-// integer names (1e-7 deg, mm). Height: the ellipsoid field when logged, else MSL.
-struct GnssFields {
-  std::string lat, lon, height;
-  double deg_per_unit = 1.0;
-  double m_per_unit = 1.0;
-  bool ellipsoid = true;
-};
-
-GnssFields GnssFieldsOf(const ULogSubscription& sub) {
-  const bool new_names = SubscriptionHasField(sub, "latitude_deg");
-  GnssFields f;
-  f.lat = new_names ? "latitude_deg" : "lat";
-  f.lon = new_names ? "longitude_deg" : "lon";
-  f.deg_per_unit = new_names ? 1.0 : 1e-7;
-  f.m_per_unit = new_names ? 1.0 : 1e-3;
-  const std::string ellipsoid = new_names ? "altitude_ellipsoid_m" : "alt_ellipsoid";
-  f.ellipsoid = SubscriptionHasField(sub, ellipsoid);
-  f.height = f.ellipsoid ? ellipsoid : (new_names ? "altitude_msl_m" : "alt");
-  return f;
-}
-
-std::vector<Candidate> GnssCandidates() {
-  return {{"vehicle_gps_position", "fix_type", ""}, {"sensor_gps", "fix_type", ""}};
-}
-
-class ULogGnssReader final : public GnssReader {
- public:
-  explicit ULogGnssReader(const std::string& path)
-      : path_(path), topic_(path, ChooseTopic(path, GnssCandidates(), "gnss")) {}
-
-  bool Next(GnssSample* s) override {
-    while (topic_.Next()) {
-      const double fix_type = topic_.Finite("fix_type");
-      if (fix_type < kMinFixType) continue;  // no 3D fix: position not usable
-      const GnssFields f = GnssFieldsOf(topic_.log().subscription());
-      const double lat_deg = topic_.Finite(f.lat) * f.deg_per_unit;
-      const double lon_deg = topic_.Finite(f.lon) * f.deg_per_unit;
-      if (std::abs(lat_deg) > 90.0 || std::abs(lon_deg) > 180.0) {
-        throw InputError::AtByte(path_, topic_.log().byte_offset(), topic_.topic() + "." + f.lat,
-                                 "latitude/longitude out of range");
-      }
-      s->t_s = topic_.t_s();
-      s->lat_rad = lat_deg * kDegToRad;
-      s->lon_rad = lon_deg * kDegToRad;
-      s->h_m = topic_.Finite(f.height) * f.m_per_unit;
-      const double eph = topic_.Sigma("eph");
-      s->pos_std_ned_m = {eph, eph, topic_.Sigma("epv")};
-      s->has_velocity =
-          !topic_.log().HasField("vel_ned_valid") || topic_.Finite("vel_ned_valid") != 0.0;
-      if (s->has_velocity) {
-        s->v_n_mps = {topic_.Finite("vel_n_m_s"), topic_.Finite("vel_e_m_s"),
-                      topic_.Finite("vel_d_m_s")};
-        s->vel_std_ned_mps = Eigen::Vector3d::Constant(topic_.Sigma("s_variance_m_s"));
-      } else {
-        s->v_n_mps.setZero();
-        s->vel_std_ned_mps.setConstant(std::numeric_limits<double>::quiet_NaN());
-      }
-      s->quality = static_cast<int>(fix_type);
-      s->num_sats = topic_.log().HasField("satellites_used")
-                        ? static_cast<int>(topic_.Finite("satellites_used"))
-                        : 0;
-      return true;
-    }
-    return false;
-  }
-  const std::string& path() const override { return path_; }
-
- private:
-  std::string path_;
-  TimeOrderedTopic topic_;
-};
-
-class ULogMagReader final : public MagReader {
- public:
-  explicit ULogMagReader(const std::string& path)
-      : path_(path),
-        source_(
-            ChooseTopic(path,
-                        {{"vehicle_magnetometer", "magnetometer_ga", ""},
-                         {"sensor_mag", "x", ""},
-                         {"sensor_combined", "magnetometer_ga", "magnetometer_timestamp_relative"}},
-                        "magnetometer")),
-        topic_(path, source_) {}
-
-  bool Next(MagSample* s) override {
-    if (!topic_.Next()) return false;
-    const bool xyz = std::string(source_.topic) == "sensor_mag";
-    const Eigen::Vector3d gauss =
-        xyz ? Eigen::Vector3d(topic_.Finite("x"), topic_.Finite("y"), topic_.Finite("z"))
-            : topic_.Vector("magnetometer_ga");
-    s->t_s = topic_.t_s();
-    s->m_b_uT = kGauss_uT * gauss;
-    return true;
-  }
-  const std::string& path() const override { return path_; }
-
- private:
-  std::string path_;
-  Candidate source_;
-  TimeOrderedTopic topic_;
-};
-
-class ULogBaroReader final : public BaroReader {
- public:
-  explicit ULogBaroReader(const std::string& path)
-      : path_(path),
-        topic_(path, ChooseTopic(path,
-                                 {{"vehicle_air_data", "baro_alt_meter", ""},
-                                  {"sensor_combined", "baro_alt_meter", "baro_timestamp_relative"}},
-                                 "barometer")) {}
-
-  bool Next(BaroSample* s) override {
-    if (!topic_.Next()) return false;
-    const ULogFile& log = topic_.log();
-    s->t_s = topic_.t_s();
-    s->altitude_m = topic_.Finite("baro_alt_meter");
-    s->pressure_pa = topic_.FiniteOrNaN("baro_pressure_pa");
-    s->temperature_degC = log.HasField("baro_temp_celcius")
-                              ? topic_.Finite("baro_temp_celcius")
-                              : topic_.FiniteOrNaN("ambient_temperature");
-    return true;
-  }
-  const std::string& path() const override { return path_; }
-
- private:
-  std::string path_;
-  TimeOrderedTopic topic_;
-};
 
 // Per-stream time statistics for DescribeULog.
 struct StreamTimes {
@@ -723,10 +430,10 @@ void AddTimeNotes(const std::string& label, const StreamTimes& times,
 }
 
 void AddGnssNote(const std::vector<ULogSubscription>& subs, std::vector<std::string>* notes) {
-  for (const Candidate& c : GnssCandidates()) {
-    const ULogSubscription* sub = FindSubscription(subs, c);
+  for (const ulog::Candidate& c : ulog::GnssCandidates()) {
+    const ULogSubscription* sub = ulog::FindSubscription(subs, c);
     if (sub == nullptr) continue;
-    const GnssFields f = GnssFieldsOf(*sub);
+    const ulog::GnssFields f = ulog::GnssFieldsOf(*sub);
     notes->push_back("GNSS from " + sub->topic + ": height from " + f.height +
                      (f.ellipsoid ? " (WGS84 ellipsoid)" : " (MSL: no ellipsoid height logged)"));
     return;
@@ -734,22 +441,6 @@ void AddGnssNote(const std::vector<ULogSubscription>& subs, std::vector<std::str
 }
 
 }  // namespace
-
-std::unique_ptr<ImuReader> OpenULogImu(const std::string& path) {
-  return std::make_unique<ULogImuReader>(path);
-}
-
-std::unique_ptr<GnssReader> OpenULogGnss(const std::string& path) {
-  return std::make_unique<ULogGnssReader>(path);
-}
-
-std::unique_ptr<MagReader> OpenULogMag(const std::string& path) {
-  return std::make_unique<ULogMagReader>(path);
-}
-
-std::unique_ptr<BaroReader> OpenULogBaro(const std::string& path) {
-  return std::make_unique<ULogBaroReader>(path);
-}
 
 FileSummary DescribeULog(const std::string& path) {
   ULogFile log(path);
@@ -778,9 +469,11 @@ FileSummary DescribeULog(const std::string& path) {
     AddTimeNotes(sub.Label(), st, &summary.notes);
   }
   summary.notes.push_back("dropouts: " + std::to_string(log.dropout_count()) + ", total " +
-                          FormatNumber(log.dropout_total_s() * 1e3) + " ms");
+                          ulog::FormatNumber(log.dropout_total_s() * 1e3) + " ms");
   summary.notes.push_back("logged messages: " + std::to_string(log.logged_strings().size()));
   AddGnssNote(log.subscriptions(), &summary.notes);
+  summary.notes.push_back("stream times above: seconds since boot; typed readers: " +
+                          FindULogClock(path).Describe());
   for (long long offset : log.appended_offsets()) {
     summary.notes.push_back("appended data from byte " + std::to_string(offset));
   }
