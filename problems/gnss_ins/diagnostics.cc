@@ -39,6 +39,11 @@ void DiagnoseCounts(const MethodRun& m, std::vector<std::string>* out) {
 
 void DiagnoseResiduals(const MethodRun& m, std::vector<std::string>* out) {
   for (const auto& [group, r] : m.solution.residuals) {
+    if (r.adapted && (r.sigma_scale > kWarnSigmaScale || r.sigma_scale < 1.0 / kWarnSigmaScale)) {
+      out->push_back(Sentence("%s: %s: the variance components scale its sigma by %.3g: the configured noise is far "
+                              "off, or its errors are not white (time-correlated)",
+                              m.name.c_str(), group.c_str(), r.sigma_scale));
+    }
     if (!(r.dof >= kWarnMinDof) || !(r.ChiSquarePerDof() > kWarnChiSquarePerDof)) continue;
     out->push_back(Sentence("%s: %s: %s %.2f over %.0f dof%s: its noise does not fit its residuals", m.name.c_str(),
                             group.c_str(), m.name == "filter" ? "NIS per dimension" : "chi2/dof",

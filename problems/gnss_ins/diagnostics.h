@@ -24,6 +24,11 @@ constexpr double kWarnMinDof = 10.0;
 /// factor either way means the sigmas are wrong (and the smoothed solution not a reference).
 constexpr double kWarnSigmaRatio = 3.0;
 
+/// A variance component that scales a group's sigma by more than this factor (or less than
+/// its inverse) is reported: the configured noise was far off, or the group's errors are not
+/// white (time-correlated GNSS errors under a noisy IMU drive the estimate towards zero).
+constexpr double kWarnSigmaScale = 10.0;
+
 /// The warnings of a finished run, one sentence each, prefixed by the method.
 std::vector<std::string> Diagnose(const GnssInsRun& run);
 

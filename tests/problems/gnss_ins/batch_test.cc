@@ -249,6 +249,7 @@ TEST_F(MemsManeuver, StandardDeviationsAreConsistentWithTheErrors) {
 // by 0.3-0.8.
 TEST_F(MemsManeuver, VarianceComponentsFindTheSimulatedNoise) {
   const auto& residuals = batch_->residuals;
+  std::cout << batch_->solver_report << "\n";
   for (const auto& [group, r] : residuals) {
     std::cout << group << ": rows " << r.rows << " dof " << r.dof << " configured chi2/dof "
               << r.configured_chi2_per_dof << " sigma x " << r.sigma_scale << " chi2/dof " << r.ChiSquarePerDof()

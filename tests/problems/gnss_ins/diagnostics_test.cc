@@ -43,9 +43,14 @@ TEST(GnssInsDiagnostics, RejectionsResetsAndMisfitsAreNamed) {
   ResidualStats misfit{300, 1200.0, 280.0};
   misfit.adapted = true;
   batch.solution.residuals["baro"] = misfit;
+  ResidualStats runaway{600, 180.0, 200.0};
+  runaway.adapted = true;
+  runaway.sigma_scale = 0.027;
+  batch.solution.residuals["gnss_position_h"] = runaway;
   run.methods = {filter, batch};
   const std::vector<std::string> w = Diagnose(run);
-  ASSERT_EQ(w.size(), 3u);
+  ASSERT_EQ(w.size(), 4u);
+  EXPECT_TRUE(Contains(w, "batch: gnss_position_h: the variance components scale its sigma by 0.027"));
   EXPECT_TRUE(Contains(w, "filter: gnss_velocity: 253 of 396 rejected by the chi-square gate (64 %)"));
   EXPECT_TRUE(Contains(w, "filter: 9 reset(s)"));
   EXPECT_TRUE(Contains(w, "batch: baro: chi2/dof 4.29 over 280 dof after variance components"));
