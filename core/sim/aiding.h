@@ -84,6 +84,7 @@ struct GnssSimConfig {
   Eigen::Vector3d velocity_sigma_ned_mps = Eigen::Vector3d::Zero();
   Eigen::Vector3d lever_arm_b_m = Eigen::Vector3d::Zero();  ///< antenna from the IMU, body axes
   double time_offset_s = 0.0;              ///< epochs at k / rate_hz + time_offset_s
+  double latency_s = 0.0;                  ///< the fix tagged t describes the antenna at t - latency_s
   std::vector<Eigen::Vector2d> outages_s;  ///< [start, end): no sample in these intervals
   double outlier_probability = 0.0;        ///< per epoch
   double outlier_size_m = 0.0;             ///< length of an outlier's position offset
@@ -105,7 +106,8 @@ struct GnssOutlier {
   Eigen::Vector3d offset_ned_m = Eigen::Vector3d::Zero();
 };
 
-/// GNSS receiver: antenna position and velocity with white noise (N(0, sigma^2) per NED
+/// GNSS receiver: antenna position and velocity (of latency_s before the tag) with white
+/// noise (N(0, sigma^2) per NED
 /// axis), outliers (with probability p an extra position offset of outlier_size_m in a
 /// uniformly random direction) and outages. The reported standard deviations are the
 /// configured sigmas (also in perfect mode: they describe the receiver), at least 1 mm and
@@ -117,7 +119,7 @@ class GnssSimulator {
   /// Throws std::invalid_argument for a configuration ParseGnssSimConfig would reject.
   GnssSimulator(const GnssSimConfig& config, const Rng& rng, bool perfect);
   std::optional<GnssSample> Push(const TruthSample& truth);
-  /// rate, sigmas, lever arm, time offset, outages, outlier settings and the outliers
+  /// rate, sigmas, lever arm, time offset, latency, outages, outlier settings and the outliers
   /// drawn so far (call after the run for the full list).
   void EmitDrawn(YAML::Emitter& out) const;
   const std::vector<GnssOutlier>& outliers() const { return outliers_; }

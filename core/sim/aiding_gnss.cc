@@ -21,12 +21,14 @@ namespace {
 
 /// Smallest standard deviation written to a GNSS sample (readers reject 0).
 constexpr double kMinReportedSigma = 1e-3;
+/// Largest receiver latency accepted (the sampler keeps this much truth in memory).
+constexpr double kMaxGnssLatency_s = 10.0;
 
 }  // namespace
 
 GnssSimConfig ParseGnssSimConfig(const ConfigNode& node) {
   node.RequireKeys({"rate_hz", "position_sigma_m", "velocity_sigma_mps", "lever_arm_b_m",
-                    "time_offset_s", "outages", "outlier_probability", "outlier_size_m",
+                    "time_offset_s", "latency_s", "outages", "outlier_probability", "outlier_size_m",
                     "start_s"});
   GnssSimConfig c;
   c.rate_hz = Rate(node, c.rate_hz, 100.0);
@@ -34,6 +36,7 @@ GnssSimConfig ParseGnssSimConfig(const ConfigNode& node) {
   c.velocity_sigma_ned_mps = SigmaNed(node, "velocity_sigma_mps");
   c.lever_arm_b_m = node.Vector("lever_arm_b_m", c.lever_arm_b_m);
   c.time_offset_s = node.Double("time_offset_s", 0.0, -kSecondsPerDay, kSecondsPerDay);
+  c.latency_s = node.Double("latency_s", 0.0, 0.0, kMaxGnssLatency_s);
   for (const ConfigNode& e : node.Elements("outages")) c.outages_s.push_back(Interval(e));
   c.outlier_probability = node.Double("outlier_probability", 0.0, 0.0, 1.0);
   c.outlier_size_m = node.NonNegative("outlier_size_m", 0.0);
@@ -77,7 +80,7 @@ GnssSample AntennaTruth(const TruthSample& truth, const Eigen::Vector3d& lever_a
 GnssSimulator::GnssSimulator(const GnssSimConfig& config, const Rng& rng, bool perfect)
     : config_(config),
       perfect_(perfect),
-      sampler_(config.rate_hz, config.time_offset_s, config.start_s),
+      sampler_(config.rate_hz, config.time_offset_s, config.start_s, config.latency_s),
       position_rng_(rng.Stream("gnss.position_noise")),
       velocity_rng_(rng.Stream("gnss.velocity_noise")),
       outlier_rng_(rng.Stream("gnss.outlier")) {
@@ -139,6 +142,7 @@ void GnssSimulator::EmitDrawn(YAML::Emitter& out) const {
   EmitVector(out, "velocity_sigma_ned_mps", config_.velocity_sigma_ned_mps);
   EmitVector(out, "lever_arm_b_m", config_.lever_arm_b_m);
   EmitValue(out, "time_offset_s", config_.time_offset_s);
+  EmitValue(out, "latency_s", config_.latency_s);
   EmitValue(out, "start_s", config_.start_s);
   out << YAML::Key << "outages_s" << YAML::Value << YAML::Flow << YAML::BeginSeq;
   for (const Eigen::Vector2d& o : config_.outages_s) {

@@ -119,6 +119,15 @@ Plan PlanStates(const std::vector<double>& anchor_times, const GnssInsConfig& co
   return plan;
 }
 
+/// The variance of a start-solution knot's horizontal attitude error (the larger axis; 0
+/// without a std).
+double KnotTiltVariance(const NavEpoch& knot) {
+  if (knot.std.size() < err::kAtt + 2) return 0.0;
+  const double n = knot.std[err::kAtt], e = knot.std[err::kAtt + 1];
+  const double v = std::max(n * n, e * e);
+  return std::isfinite(v) ? v : 0.0;
+}
+
 /// The parameter blocks and the initial information of one state.
 struct BatchState {
   double t_s = 0.0;
@@ -132,6 +141,7 @@ struct BatchState {
   double* ba_block = nullptr;
   InsState initial;             ///< mechanized from the start solution (scale factors used)
   Eigen::Vector3d omega_ib_b_radps = Eigen::Vector3d::Zero();  ///< bias-corrected, at t_s
+  ins::ImuMotion motion;        ///< MotionWindow at t_s
   bool still = false;           ///< the stillness rule holds at t_s
 };
 
@@ -312,6 +322,7 @@ void BatchSmoother::MakeViews() {
     v.q = s.q.data();
     v.initial = &s.initial;
     v.omega_ib_b_radps = s.omega_ib_b_radps;
+    v.motion = s.motion;
     v.still = s.still;
     v.anchor = s.anchor;
   }
@@ -336,6 +347,8 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   const ins::StillnessConfig* still_rule = ins::StillnessRule(sources_);
   std::optional<ins::StillnessDetector> detector;
   if (still_rule != nullptr) detector.emplace(*still_rule);
+  ins::MotionWindow motion(noise.gyro_arw_rad_per_sqrt_s, noise.accel_vrw_mps_per_sqrt_s);
+  double tilt_var = KnotTiltVariance(knots.front());  // of the knot the mechanization started at
   ImuErrors scale;  // the scale factors of the current interval (biases zero)
 
   // The bias blocks' initial values: each state's from its knot, shared ones from the first.
@@ -345,6 +358,7 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     s.initial.nav.t_s = s.t_s;
     s.initial.imu = errors;
     s.omega_ib_b_radps = omega;
+    s.motion = motion.Get(tilt_var);
     s.still = detector && detector->Still();
     const NavState& nav = s.initial.nav;
     s.pos = {nav.lat_rad, nav.lon_rad, nav.h_m};
@@ -378,13 +392,16 @@ void BatchSmoother::MechanizeAndPreintegrate() {
       nav.t_s = strapdown.state().t_s;
       strapdown.SetState(nav);
       errors = knots[kn].state.imu;
+      tilt_var = KnotTiltVariance(knots[kn]);
       ++kn;
     }
     while (si < n && states_[si].t_s <= t + ins::kSameEpoch_s) record_state();
   };
   const auto step = [&](const ImuSample& piece) {
     const ImuSample c = CorrectImu(piece, errors);
+    const Eigen::Vector3d v_before_n_mps = strapdown.state().v_n_mps;
     strapdown.Update(c);
+    motion.Add(c, strapdown.state().v_n_mps - v_before_n_mps);
     omega = c.dtheta_b_rad / c.dt_s;
     pre_[si - 1]->Integrate(CorrectImu(piece, scale));
     ++imu_samples_;
@@ -732,7 +749,7 @@ Solution BatchSmoother::Run() {
   if (cfg_.batch.covariance) Covariance(&solution, &report);
   solution.counts = counts_;
   solution.residuals = ResidualSummary(configured_stats_, final_stats_);
-  for (const ins::AuxState& a : aux_states_) solution.aux_names.push_back(a.name);
+  solution.aux_states = aux_states_;
   solution.solver_report = report.str();
   if (!solution.solver_report.empty() && solution.solver_report.back() == '\n') solution.solver_report.pop_back();
   solution.run_time_s = Seconds(wall_start);

@@ -360,10 +360,14 @@ VehicleConfig ParseVehicle(const ConfigNode& n) {
   return x;
 }
 
+/// The largest |gnss.time_offset_s| accepted.
+constexpr double kMaxGnssTimeOffset_s = 1.0;
+
 GnssConfig ParseGnss(const ConfigNode& n) {
   n.RequireKeys({"use_velocity", "pos_std_floor_m", "vel_std_floor_mps", "default_pos_std_m",
                  "default_vel_std_mps", "max_distance_m", "pos_sigma_scale_h", "pos_sigma_scale_v",
-                 "vel_sigma_scale_h", "vel_sigma_scale_v"});
+                 "vel_sigma_scale_h", "vel_sigma_scale_v", "estimate_lever_arm", "lever_arm_std_m",
+                 "estimate_time_offset", "time_offset_s", "time_offset_std_s"});
   GnssConfig x;
   x.use_velocity = n.Bool("use_velocity", x.use_velocity);
   x.pos_std_floor_m = NonNegative(n, "pos_std_floor_m", x.pos_std_floor_m);
@@ -375,6 +379,13 @@ GnssConfig ParseGnss(const ConfigNode& n) {
   x.pos_sigma_scale_v = Sigma(n, "pos_sigma_scale_v", x.pos_sigma_scale_v);
   x.vel_sigma_scale_h = Sigma(n, "vel_sigma_scale_h", x.vel_sigma_scale_h);
   x.vel_sigma_scale_v = Sigma(n, "vel_sigma_scale_v", x.vel_sigma_scale_v);
+  x.estimate_lever_arm = n.Bool("estimate_lever_arm", x.estimate_lever_arm);
+  x.lever_arm_std_m = SigmaVector(n, "lever_arm_std_m", x.lever_arm_std_m);
+  x.estimate_time_offset = n.Bool("estimate_time_offset", x.estimate_time_offset);
+  // The model is first order in the offset (factors/gnss_installation.h): receivers' latencies
+  // are tens to hundreds of milliseconds.
+  x.time_offset_s = n.Double("time_offset_s", x.time_offset_s, -kMaxGnssTimeOffset_s, kMaxGnssTimeOffset_s);
+  x.time_offset_std_s = Sigma(n, "time_offset_std_s", x.time_offset_std_s);
   return x;
 }
 

@@ -67,6 +67,9 @@ class NavigationFilter : public ins::FilterAccess {
   }
   double aux(int i) const override { return aux_[aux_begin_[current_] + i]; }
   const Eigen::Vector3d& omega_ib_b_radps() const override { return omega_ib_b_; }
+  ins::ImuMotion motion() const override {
+    return motion_.Get(std::max(P_(err::kAtt, err::kAtt), P_(err::kAtt + 1, err::kAtt + 1)));
+  }
   double time_s() const override { return epoch_t_s_; }
   bool still() const override { return detector_ && detector_->Still(); }
   bool Update(std::unique_ptr<ceres::CostFunction> cost, const std::vector<StateBlock>& blocks,
@@ -89,7 +92,7 @@ class NavigationFilter : public ins::FilterAccess {
       for (const ins::AuxState& a : source->aux_states()) {
         aux_values.push_back(a.initial);
         aux_std0_.push_back(a.initial_std);
-        aux_names_.push_back(a.name);
+        aux_states_.push_back(a);
       }
     }
     aux_ = Eigen::Map<const Eigen::VectorXd>(aux_values.data(), static_cast<Eigen::Index>(aux_values.size()));
@@ -110,7 +113,9 @@ class NavigationFilter : public ins::FilterAccess {
   /// Mechanizes one (piece of a) sample and adds it to the covariance group.
   void Propagate(const ImuSample& raw) {
     const ImuSample c = ins::CorrectImu(raw, imu_);
+    const Eigen::Vector3d v_before_n_mps = strapdown_.state().v_n_mps;
     strapdown_.Update(c);
+    motion_.Add(c, strapdown_.state().v_n_mps - v_before_n_mps);
     group_dtheta_ += c.dtheta_b_rad;
     group_dv_ += c.dv_b_mps;
     group_dt_ += c.dt_s;
@@ -264,7 +269,7 @@ class NavigationFilter : public ins::FilterAccess {
   Eigen::VectorXd aux_;       ///< the sources' auxiliary states (nominal)
   Eigen::VectorXd aux_psd_;
   std::vector<double> aux_std0_;
-  std::vector<std::string> aux_names_;
+  std::vector<ins::AuxState> aux_states_;
   std::vector<int> aux_begin_;        ///< per source: its first auxiliary state
   std::vector<std::size_t> next_;     ///< per source: its next sample
   std::size_t current_ = 0;           ///< the source being processed
@@ -279,6 +284,7 @@ class NavigationFilter : public ins::FilterAccess {
   Eigen::Vector3d group_dv_ = Eigen::Vector3d::Zero();
   double group_dt_ = 0.0;
   Eigen::Vector3d omega_ib_b_ = Eigen::Vector3d::Zero();  ///< of the last (piece of a) sample
+  ins::MotionWindow motion_{cfg_.imu_noise.gyro_arw_rad_per_sqrt_s, cfg_.imu_noise.accel_vrw_mps_per_sqrt_s};
   Eigen::MatrixXd P_;
   Eigen::MatrixXd phi_acc_;  ///< transition since the previous knot (RTS)
   std::optional<ErrorStateKalmanFilter> kf_;  ///< the update engine; P_ is propagated here
@@ -468,7 +474,7 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
   result.filter.method = "filter";
   result.filter.epochs = std::move(epochs_);
   result.filter.counts = counts_;
-  result.filter.aux_names = aux_names_;
+  result.filter.aux_states = aux_states_;
   result.filter.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (run_rts_) {
     const RtsResult smoothed = RunRts(knots_);
@@ -477,7 +483,7 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
     Solution rts;
     rts.method = "rts";
     rts.counts = counts_;
-    rts.aux_names = aux_names_;
+    rts.aux_states = aux_states_;
     rts.epochs.reserve(smoothed.dx.size());
     for (std::size_t i = 0; i < smoothed.dx.size(); ++i) {
       const NavEpoch& knot = result.filter.epochs[i];

@@ -305,17 +305,46 @@ void AppendConsistencyTable(std::string* s, const GnssInsRun& run) {
   }
 }
 
-/// The auxiliary states (the aiding sources' parameters) at the end of a solution, with
-/// their std (NaN when not computed), dimensionless SI values.
-void WriteAuxStates(JsonWriter& w, const Solution& solution) {
-  if (solution.aux_names.empty() || solution.epochs.empty()) return;
+/// A parameter whose posterior std at the end of the record is at least this fraction of its
+/// prior std is not observable from the record: the data hardly moved its uncertainty.
+constexpr double kUnobservableSigmaRatio = 0.9;
+
+/// Auxiliary state i at the end of a solution: value, posterior std (NaN when not computed)
+/// and whether the record observed it (posterior std below kUnobservableSigmaRatio times the
+/// prior; a state held at its prior or without a computed std counts as observed: nothing
+/// to say).
+struct AuxEnd {
+  double value = std::nan("");
+  double std = std::nan("");
+  double prior_std = 0.0;
+  bool observable = true;
+};
+
+AuxEnd AuxAtEnd(const Solution& solution, std::size_t i) {
+  AuxEnd a;
+  const Eigen::Index k = static_cast<Eigen::Index>(i);
   const NavEpoch& last = solution.epochs.back();
+  if (k < last.aux.size()) a.value = last.aux[k];
+  if (k < last.aux_std.size()) a.std = last.aux_std[k];
+  a.prior_std = solution.aux_states[i].initial_std;
+  a.observable = !(a.prior_std > 0.0 && a.std >= kUnobservableSigmaRatio * a.prior_std);
+  return a;
+}
+
+/// The auxiliary states (the aiding sources' parameters) at the end of a solution, with
+/// their std, prior std and observability, dimensionless SI values.
+void WriteAuxStates(JsonWriter& w, const Solution& solution) {
+  if (solution.aux_states.empty() || solution.epochs.empty()) return;
   w.Key("aux").BeginObject();
-  for (std::size_t i = 0; i < solution.aux_names.size(); ++i) {
-    const Eigen::Index k = static_cast<Eigen::Index>(i);
-    const double value = k < last.aux.size() ? last.aux[k] : std::nan("");
-    const double std = k < last.aux_std.size() ? last.aux_std[k] : std::nan("");
-    w.Key(solution.aux_names[i]).BeginObject().Field("value", value).Field("std", std).EndObject();
+  for (std::size_t i = 0; i < solution.aux_states.size(); ++i) {
+    const AuxEnd a = AuxAtEnd(solution, i);
+    w.Key(solution.aux_states[i].name)
+        .BeginObject()
+        .Field("value", a.value)
+        .Field("std", a.std)
+        .Field("prior_std", a.prior_std)
+        .Field("observable", a.observable)
+        .EndObject();
   }
   w.EndObject();
 }
@@ -340,20 +369,29 @@ void WriteResiduals(JsonWriter& w, const Solution& solution) {
   w.EndObject();
 }
 
-/// One line per auxiliary state: each method's value at the end +- its std.
+/// One line per auxiliary state: each method's value at the end +- its std, or "not
+/// observable" when the record left its std near the prior, followed by the reason.
 void AppendAuxStates(std::string* s, const GnssInsRun& run) {
   if (run.methods.empty()) return;
-  const std::vector<std::string>& names = run.methods.front().solution.aux_names;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    const Eigen::Index k = static_cast<Eigen::Index>(i);
-    Append(s, "%s at the end:", names[i].c_str());
+  const std::vector<ins::AuxState>& states = run.methods.front().solution.aux_states;
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    Append(s, "%s at the end:", states[i].name.c_str());
+    bool unobserved = false;
     for (const MethodRun& m : run.methods) {
-      if (m.solution.epochs.empty() || m.solution.epochs.back().aux.size() <= k) continue;
-      const NavEpoch& last = m.solution.epochs.back();
-      const double std = last.aux_std.size() > k ? last.aux_std[k] : std::nan("");
-      Append(s, " %s %.6g +- %.2g", m.name.c_str(), last.aux[k], std);
+      if (m.solution.epochs.empty() || m.solution.aux_states.size() <= i) continue;
+      const AuxEnd a = AuxAtEnd(m.solution, i);
+      if (a.observable) {
+        Append(s, " %s %.6g +- %.2g", m.name.c_str(), a.value, a.std);
+      } else {
+        Append(s, " %s not observable", m.name.c_str());
+        unobserved = true;
+      }
     }
     Append(s, "\n");
+    if (unobserved) {
+      Append(s, "  not observable from this record: posterior sigma >= %.1f x prior sigma %.3g; it needs %s\n",
+             kUnobservableSigmaRatio, states[i].initial_std, states[i].observed_by.c_str());
+    }
   }
 }
 
@@ -525,6 +563,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
     for (const MethodRun& m : run.methods) {
       Append(&s, "%-14s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
     }
+    AppendAuxStates(&s, run);
     AppendResidualStats(&s, run);
     AppendAdaptedNoise(&s, run);
     AppendWarnings(&s, run);

@@ -90,6 +90,10 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
          "  noise_uT: " << Num(noise_uT) << "\n"
          "  heading_std_deg: " << Num(heading_std_deg) << "\n";
   }
+  if (scenario.gnss->latency_s != 0.0) {
+    y << "gnss:\n"
+         "  time_offset_s: " << Num(scenario.gnss->latency_s) << "   # the receiver's latency\n";
+  }
   y << "filter:\n"
        "  scale_factors: true\n";
   return y.str();

@@ -1,6 +1,7 @@
 // The navtwin configuration (docs/gnss-ins.md) a user of a simulated scenario would write:
 // the scenario's IMU specification (noise densities, turn-on bias and scale-factor
-// sigmas), the installation, the initial state from init.nav, and, for the magnetometer,
+// sigmas), the installation (lever arm; a GNSS latency as gnss.time_offset_s), the initial
+// state from init.nav, and, for the magnetometer,
 // the calibration and Earth field the simulation drew (errors.yaml) — what a user gets
 // from a magnetometer calibration and a field model. Used by `navtwin smooth --demo`.
 #pragma once

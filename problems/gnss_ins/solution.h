@@ -45,9 +45,9 @@ struct Solution {
   /// "gnss_position_v", ...; AidingSource::row_groups), and for the batch "imu" (the
   /// preintegrated increments), "gyro_bias_process", "accel_bias_process", "prior".
   std::map<std::string, ResidualStats> residuals;
-  /// Names of the epochs' auxiliary states (NavEpoch::aux; the aiding sources' parameters,
-  /// e.g. "odometer_scale"), in order.
-  std::vector<std::string> aux_names;
+  /// The epochs' auxiliary states (NavEpoch::aux; the aiding sources' parameters, e.g.
+  /// "odometer_scale"), in order: names, priors and what observes them.
+  std::vector<ins::AuxState> aux_states;
   double run_time_s = 0.0;
   std::string solver_report;  ///< batch: Ceres' brief report; filter: empty
 };

@@ -17,6 +17,7 @@
 
 #include "core/types.h"
 #include "problems/ins/ins_state.h"
+#include "problems/ins/measurement_rules.h"
 
 namespace ceres {
 class CostFunction;
@@ -47,6 +48,9 @@ struct AuxState {
   std::string name;  ///< e.g. "odometer_scale"
   double initial = 0.0;
   double initial_std = 0.0;
+  /// What in a record makes it observable, for the report of a state whose posterior std
+  /// stays near its prior ("rotation about the body x and y axes").
+  std::string observed_by;
 };
 
 /// The filter as a source sees it at an update epoch.
@@ -59,6 +63,9 @@ class FilterAccess {
   virtual double aux(int i) const = 0;
   /// Bias-corrected angular rate of the last (piece of an) IMU sample, body axes.
   virtual const Eigen::Vector3d& omega_ib_b_radps() const = 0;
+  /// The nominal mechanization's motion at the epoch (rate, angular acceleration, NED
+  /// acceleration and jerk) from the last IMU samples (MotionWindow, measurement_rules.h).
+  virtual ImuMotion motion() const = 0;
   /// The epoch's time (an IMU epoch, or a sample time where the IMU sample is split).
   virtual double time_s() const = 0;
   /// The stillness rule over the IMU samples up to this epoch (the first source's
@@ -92,6 +99,9 @@ class BatchAccess {
     double* q = nullptr;    ///< q_n_b x, y, z, w
     const InsState* initial = nullptr;  ///< mechanized from the start solution
     Eigen::Vector3d omega_ib_b_radps = Eigen::Vector3d::Zero();  ///< bias-corrected, at t_s
+    /// The mechanization's motion at t_s from the IMU samples before it (MotionWindow,
+    /// measurement_rules.h; zero at the first state).
+    ImuMotion motion;
     bool still = false;     ///< the stillness rule holds at t_s
     long anchor = -1;       ///< the anchoring source's sample placed at this state (-1: none)
   };

@@ -28,7 +28,10 @@ class OdometerSource : public AidingSource {
   std::vector<std::string> keys() const override { return {kOdometer}; }
   Timing timing() const override { return Timing::kExact; }
   const std::vector<double>& times() const override { return times_; }
-  std::vector<AuxState> aux_states() const override { return {{"odometer_scale", 0.0, config_.scale_std}}; }
+  std::vector<AuxState> aux_states() const override {
+    return {{"odometer_scale", 0.0, config_.scale_std, "driving with GNSS (the odometer's speeds against the aided "
+                                                       "velocity)"}};
+  }
 
   void FilterUpdate(std::size_t k, FilterAccess& filter) override {
     filter.Update(std::unique_ptr<ceres::CostFunction>(Create(filter.omega_ib_b_radps(), samples_[k].speed_mps)),

@@ -213,6 +213,30 @@ TEST(AidingTest, PerfectGnssIsTheAntennaTruthAndReportsTheConfiguredSigma) {
   EXPECT_TRUE(gnss.outliers().empty());
 }
 
+TEST(AidingTest, GnssLatencyReportsTheAntennaOfTheEarlierTime) {
+  Wobble wobble;
+  const std::vector<TruthSample> truth = TruthStream(wobble, 200.0, 10.0);
+  GnssSimConfig c;
+  c.rate_hz = 10.0;
+  c.lever_arm_b_m = Eigen::Vector3d(0.5, -0.2, -1.0);
+  c.latency_s = 0.15;  // 30 truth samples
+  GnssSimulator gnss(c, Rng(7), true);
+  const std::vector<GnssSample> out = Feed<GnssSample>(gnss, truth);
+  // Tags k / 10 whose data time t - 0.15 lies in the truth [0, 10]: 0.2 ... 10.
+  ASSERT_EQ(out.size(), 99u);
+  EXPECT_NEAR(out.front().t_s, 0.2, 1e-12);
+  for (const GnssSample& g : out) {
+    const std::size_t k = static_cast<std::size_t>(std::lround((g.t_s - c.latency_s) * 200.0));
+    const GnssSample ref = AntennaTruth(truth[k], c.lever_arm_b_m);
+    EXPECT_EQ(g.lat_rad, ref.lat_rad);
+    EXPECT_EQ(g.h_m, ref.h_m);
+    EXPECT_EQ(g.v_n_mps, ref.v_n_mps);
+  }
+  YAML::Emitter e;
+  gnss.EmitDrawn(e);
+  EXPECT_EQ(YAML::Load(e.c_str())["latency_s"].as<double>(), 0.15);
+}
+
 struct GnssErrors {
   std::vector<Eigen::Vector3d> position, velocity;
   std::vector<GnssSample> samples;
@@ -546,7 +570,7 @@ TEST(AidingTest, MasterAttitudeRandomWalkGrowsLikeSqrtTime) {
 TEST(AidingTest, ParsesEverySection) {
   const ConfigNode root = Yaml(R"(
 gnss: {rate_hz: 5, position_sigma_m: [1.5, 3], velocity_sigma_mps: 0.05,
-       lever_arm_b_m: [0.5, 0, -1], time_offset_s: 0.1, outages: [[10, 20], [30, 31]],
+       lever_arm_b_m: [0.5, 0, -1], time_offset_s: 0.1, latency_s: 0.12, outages: [[10, 20], [30, 31]],
        outlier_probability: 0.01, outlier_size_m: 30, start_s: 1}
 mag: {rate_hz: 20, declination_deg: -8, inclination_deg: 53, intensity_uT: 50,
       hard_iron_fixed_uT: [1, 2, 3], soft_iron: 0.02, soft_iron_symmetric: true,
@@ -560,6 +584,7 @@ master: {rate_hz: 100, transfer_delay_s: 0.3, attitude_error_sigma_mrad: 1,
   EXPECT_EQ(g.position_sigma_ned_m, Eigen::Vector3d(1.5, 1.5, 3.0));
   EXPECT_EQ(g.velocity_sigma_ned_mps, Eigen::Vector3d::Constant(0.05));
   EXPECT_EQ(g.lever_arm_b_m, Eigen::Vector3d(0.5, 0.0, -1.0));
+  EXPECT_EQ(g.latency_s, 0.12);
   ASSERT_EQ(g.outages_s.size(), 2u);
   EXPECT_EQ(g.outages_s[1], Eigen::Vector2d(30.0, 31.0));
   EXPECT_EQ(g.outlier_size_m, 30.0);

@@ -162,6 +162,40 @@ init: {source: static}
   ExpectInputError([&] { LoadGnssInsConfig(init); }, {init, "line 8", "init.position_std_m"});
 }
 
+// The GNSS installation keys (docs/gnss-ins.md "GNSS installation parameters"): defaults off,
+// 0.5 m, 0 s and 0.2 s; the lever arm's std a scalar or per axis; the offset within +-1 s.
+TEST(GnssInsConfig, GnssInstallationKeys) {
+  const std::string head = R"(imu_noise:
+  gyro_arw_deg_sqrt_h: 0.1
+  accel_vrw_m_s_sqrt_h: 0.1
+  gyro_bias_std_deg_h: 1
+  accel_bias_std_ug: 100
+init: {source: static}
+)";
+  const GnssInsConfig d = LoadGnssInsConfig(WriteTempFile("d.yaml", head));
+  EXPECT_FALSE(d.gnss.estimate_lever_arm);
+  EXPECT_FALSE(d.gnss.estimate_time_offset);
+  EXPECT_EQ(d.gnss.lever_arm_std_m, Eigen::Vector3d::Constant(0.5));
+  EXPECT_EQ(d.gnss.time_offset_s, 0.0);
+  EXPECT_EQ(d.gnss.time_offset_std_s, 0.2);
+  const GnssInsConfig c = LoadGnssInsConfig(WriteTempFile(
+      "c.yaml", head + "gnss: {estimate_lever_arm: true, lever_arm_std_m: [0.2, 0.3, 1.0], estimate_time_offset: "
+                       "true, time_offset_s: 0.1, time_offset_std_s: 0.05}\n"));
+  EXPECT_TRUE(c.gnss.estimate_lever_arm);
+  EXPECT_TRUE(c.gnss.estimate_time_offset);
+  EXPECT_EQ(c.gnss.lever_arm_std_m, Eigen::Vector3d(0.2, 0.3, 1.0));
+  EXPECT_EQ(c.gnss.time_offset_s, 0.1);
+  EXPECT_EQ(c.gnss.time_offset_std_s, 0.05);
+  const std::string scalar = WriteTempFile("s.yaml", head + "gnss: {lever_arm_std_m: 0.1}\n");
+  EXPECT_EQ(LoadGnssInsConfig(scalar).gnss.lever_arm_std_m, Eigen::Vector3d::Constant(0.1));
+  const std::string far = WriteTempFile("far.yaml", head + "gnss:\n  time_offset_s: 1.5\n");
+  ExpectInputError([&] { LoadGnssInsConfig(far); }, {far, "line 8", "gnss.time_offset_s"});
+  const std::string zero = WriteTempFile("z.yaml", head + "gnss:\n  lever_arm_std_m: [0.1, 0, 0.1]\n");
+  ExpectInputError([&] { LoadGnssInsConfig(zero); }, {zero, "line 8", "gnss.lever_arm_std_m"});
+  const std::string zero_t = WriteTempFile("zt.yaml", head + "gnss:\n  time_offset_std_s: 0\n");
+  ExpectInputError([&] { LoadGnssInsConfig(zero_t); }, {zero_t, "line 8", "gnss.time_offset_std_s"});
+}
+
 TEST(GnssInsConfig, UnknownAndMissingKeys) {
   const std::string typo = WriteTempFile(
       "typo.yaml", "imu_noise:\n  gyro_arw_deg_sqrt_hr: 0.1\n");
