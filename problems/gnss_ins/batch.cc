@@ -223,7 +223,7 @@ class BatchSmoother : public ins::BatchAccess {
   int Reintegrate();
   BatchReport SolveWithReintegration(const BatchOptions& options, const std::string& label,
                                      std::ostringstream* report);
-  void AdaptNoise(const BatchOptions& options, std::ostringstream* report);
+  void EstimateVarianceComponents(const BatchOptions& options, std::ostringstream* report);
   void Covariance(Solution* solution, std::ostringstream* report);
   std::vector<int> SourceRowGroups(const std::string& key);
   ceres::CostFunction* Group(ceres::CostFunction* cost, const char* group, bool estimable = true) {
@@ -613,7 +613,7 @@ BatchReport BatchSmoother::SolveWithReintegration(const BatchOptions& options, c
 /// The residual statistics with the configured noise, and with config.batch.variance_components
 /// the iterated variance-component estimate: factors updated, problem solved again, until
 /// every estimable group's chi2 / dof is within kVarianceTolerance of 1.
-void BatchSmoother::AdaptNoise(const BatchOptions& options, std::ostringstream* report) {
+void BatchSmoother::EstimateVarianceComponents(const BatchOptions& options, std::ostringstream* report) {
   const int threads = std::max(1, cfg_.batch.threads);
   std::string failure;
   configured_stats_ = groups_.Evaluate(*problem_, true, threads, &failure);
@@ -726,7 +726,7 @@ Solution BatchSmoother::Run() {
   options.progress = progress_ != nullptr;
   std::ostringstream report;
   SolveWithReintegration(options, "solve", &report);
-  AdaptNoise(options, &report);
+  EstimateVarianceComponents(options, &report);
 
   Solution solution;
   solution.method = "batch";

@@ -62,7 +62,7 @@ void DiagnoseConsistency(const MethodRun& m, std::vector<std::string>* out) {
   std::string offending;
   for (int k = 0; k < kScoredComponents; ++k) {
     const double ratio = c.RmsRatio(k);
-    if (c.count(k) < kWarnMinDof || !(ratio > kWarnSigmaRatio || ratio < 1.0 / kWarnSigmaRatio)) continue;
+    if (c.count(k) < kWarnMinEpochs || !(ratio > kWarnSigmaRatio || ratio < 1.0 / kWarnSigmaRatio)) continue;
     offending += Sentence("%s%s %.2f", offending.empty() ? "" : ", ", kNames[k], ratio);
   }
   if (offending.empty()) return;

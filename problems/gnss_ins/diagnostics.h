@@ -5,6 +5,7 @@
 // failing exit code.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ constexpr double kWarnRejectedFraction = 0.10;
 constexpr double kWarnChiSquarePerDof = 3.0;
 /// Residual groups with fewer degrees of freedom are not judged.
 constexpr double kWarnMinDof = 10.0;
+/// Nor is err/sigma over fewer compared reference epochs.
+constexpr std::size_t kWarnMinEpochs = 10;
 /// The reference's errors against the reported sigma: an RMS of err / sigma beyond this
 /// factor either way means the sigmas are wrong (and the smoothed solution not a reference).
 constexpr double kWarnSigmaRatio = 3.0;
