@@ -26,7 +26,8 @@ struct ImuFactorData {
   Eigen::Quaterniond delta_q = Eigen::Quaterniond::Identity();
   Eigen::Vector3d delta_v = Eigen::Vector3d::Zero(), delta_p = Eigen::Vector3d::Zero();
   Eigen::Matrix3d J_R_bg, J_v_bg, J_v_ba, J_p_bg, J_p_ba;
-  Eigen::Vector3d bg_lin = Eigen::Vector3d::Zero(), ba_lin = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d J_R_sg, J_v_sg, J_p_sg, J_v_sa, J_p_sa;
+  ImuErrors lin;
   Matrix9d sqrt_information = Matrix9d::Identity();  // S = L^-1
   bool whiten = true;
 };
@@ -45,16 +46,22 @@ ImuFactorData MakeData(const ImuPreintegration& pre, bool whiten) {
   d.J_v_ba = pre.J_v_ba();
   d.J_p_bg = pre.J_p_bg();
   d.J_p_ba = pre.J_p_ba();
-  d.bg_lin = pre.bg_lin_radps();
-  d.ba_lin = pre.ba_lin_mps2();
+  d.J_R_sg = pre.J_R_sg();
+  d.J_v_sg = pre.J_v_sg();
+  d.J_p_sg = pre.J_p_sg();
+  d.J_v_sa = pre.J_v_sa();
+  d.J_p_sa = pre.J_p_sa();
+  d.lin = pre.lin();
   d.whiten = whiten;
   if (whiten) d.sqrt_information = pre.SqrtInformation();
   return d;
 }
 
 // The IMU residual (docs/imu-preintegration.md). With dt = t_j - t_i, dbg = bg_i - bg_lin,
-// dba = ba_i - ba_lin, the bias-corrected increments
-//   dR = dR_lin Exp(J_R_bg dbg),  dv = dv_lin + J_v_bg dbg + J_v_ba dba,  dp likewise,
+// dba = ba_i - ba_lin (and dsg = sg_i - sg_lin, dsa = sa_i - sa_lin when the scale factors
+// are unknowns, else zero), the corrected increments
+//   dR = dR_lin Exp(J_R_bg dbg + J_R_sg dsg),
+//   dv = dv_lin + J_v_bg dbg + J_v_ba dba + J_v_sg dsg + J_v_sa dsa,  dp likewise,
 // the midpoint lat_m = (lat_i + lat_j)/2, h_m = (h_i + h_j)/2, the displacement
 //   D = NED displacement i -> j with the radii at (lat_m, h_m)   (= integral of v_n dt),
 // the mean velocity v_m = D / dt, and
@@ -76,19 +83,34 @@ class ImuFactor {
   explicit ImuFactor(ImuFactorData data) : d_(std::move(data)) {}
 
   template <typename T>
-  bool operator()(const T* pos_i, const T* vel_i, const T* q_i_ptr, const T* bg_i, const T* ba_i,
-                  const T* pos_j, const T* vel_j, const T* q_j_ptr, T* residual_ptr) const {
+  bool operator()(const T* pos_i, const T* vel_i, const T* q_i, const T* bg_i, const T* ba_i, const T* pos_j,
+                  const T* vel_j, const T* q_j, T* residual) const {
+    return Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, nullptr, nullptr, pos_j, vel_j, q_j, residual);
+  }
+
+  /// sg_i, sa_i null: the scale factors at the linearisation point.
+  template <typename T>
+  bool Evaluate(const T* pos_i, const T* vel_i, const T* q_i_ptr, const T* bg_i, const T* ba_i, const T* sg_i,
+                const T* sa_i, const T* pos_j, const T* vel_j, const T* q_j_ptr, T* residual_ptr) const {
     const T dt(d_.dt_s);
     const Eigen::Map<const Vector3<T>> v_i(vel_i), v_j(vel_j);
     const Quaternion<T> q_i = Eigen::Map<const Quaternion<T>>(q_i_ptr).normalized();
     const Quaternion<T> q_j = Eigen::Map<const Quaternion<T>>(q_j_ptr).normalized();
-    const Vector3<T> dbg = Eigen::Map<const Vector3<T>>(bg_i) - d_.bg_lin.cast<T>();
-    const Vector3<T> dba = Eigen::Map<const Vector3<T>>(ba_i) - d_.ba_lin.cast<T>();
+    const Vector3<T> dbg = Eigen::Map<const Vector3<T>>(bg_i) - d_.lin.bg_radps.cast<T>();
+    const Vector3<T> dba = Eigen::Map<const Vector3<T>>(ba_i) - d_.lin.ba_mps2.cast<T>();
 
-    // Bias-corrected increments (first order).
-    const Quaternion<T> dq = d_.delta_q.cast<T>() * QuatFromRotVec<T>(d_.J_R_bg.cast<T>() * dbg);
-    const Vector3<T> dv = d_.delta_v.cast<T>() + d_.J_v_bg.cast<T>() * dbg + d_.J_v_ba.cast<T>() * dba;
-    const Vector3<T> dp = d_.delta_p.cast<T>() + d_.J_p_bg.cast<T>() * dbg + d_.J_p_ba.cast<T>() * dba;
+    // Corrected increments (first order).
+    Vector3<T> dphi = d_.J_R_bg.cast<T>() * dbg;
+    Vector3<T> dv = d_.delta_v.cast<T>() + d_.J_v_bg.cast<T>() * dbg + d_.J_v_ba.cast<T>() * dba;
+    Vector3<T> dp = d_.delta_p.cast<T>() + d_.J_p_bg.cast<T>() * dbg + d_.J_p_ba.cast<T>() * dba;
+    if (sg_i != nullptr) {
+      const Vector3<T> dsg = Eigen::Map<const Vector3<T>>(sg_i) - d_.lin.sg.cast<T>();
+      const Vector3<T> dsa = Eigen::Map<const Vector3<T>>(sa_i) - d_.lin.sa.cast<T>();
+      dphi += d_.J_R_sg.cast<T>() * dsg;
+      dv += d_.J_v_sg.cast<T>() * dsg + d_.J_v_sa.cast<T>() * dsa;
+      dp += d_.J_p_sg.cast<T>() * dsg + d_.J_p_sa.cast<T>() * dsa;
+    }
+    const Quaternion<T> dq = d_.delta_q.cast<T>() * QuatFromRotVec<T>(dphi);
 
     // Earth model at the interval midpoint, with the mean velocity over the interval.
     const T lat_m = (pos_i[0] + pos_j[0]) * T(0.5);
@@ -137,19 +159,55 @@ class ImuFactor {
   ImuFactorData d_;
 };
 
+/// The factor with the scale-factor blocks (CreateImuScaleFactor).
+class ImuScaleFactor {
+ public:
+  explicit ImuScaleFactor(ImuFactorData data) : factor_(std::move(data)) {}
+
+  template <typename T>
+  bool operator()(const T* pos_i, const T* vel_i, const T* q_i, const T* bg_i, const T* ba_i, const T* sg_i,
+                  const T* sa_i, const T* pos_j, const T* vel_j, const T* q_j, T* residual) const {
+    return factor_.Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, pos_j, vel_j, q_j, residual);
+  }
+
+ private:
+  ImuFactor factor_;
+};
+
+}  // namespace
+
+namespace {
+
+/// Biases and scale factors a preintegration can be linearised at: finite, 1 + s > 0.
+void CheckLinearisation(const ImuErrors& lin, const char* where) {
+  if (!lin.bg_radps.allFinite() || !lin.ba_mps2.allFinite()) {
+    throw std::invalid_argument(std::string(where) + ": the linearisation biases must be finite");
+  }
+  if (!lin.sg.allFinite() || !lin.sa.allFinite() || (lin.sg.array() <= -1.0).any() ||
+      (lin.sa.array() <= -1.0).any()) {
+    throw std::invalid_argument(std::string(where) + ": the linearisation scale factors must be finite and above -1");
+  }
+}
+
+ImuErrors BiasesOnly(const Eigen::Vector3d& bg_radps, const Eigen::Vector3d& ba_mps2) {
+  ImuErrors e;
+  e.bg_radps = bg_radps;
+  e.ba_mps2 = ba_mps2;
+  return e;
+}
+
 }  // namespace
 
 ImuPreintegration::ImuPreintegration(const Eigen::Vector3d& bg_lin_radps,
                                      const Eigen::Vector3d& ba_lin_mps2,
                                      double gyro_arw_rad_per_sqrt_s,
                                      double accel_vrw_mps_per_sqrt_s)
-    : bg_lin_(bg_lin_radps),
-      ba_lin_(ba_lin_mps2),
-      gyro_arw_(gyro_arw_rad_per_sqrt_s),
-      accel_vrw_(accel_vrw_mps_per_sqrt_s) {
-  if (!bg_lin_radps.allFinite() || !ba_lin_mps2.allFinite()) {
-    throw std::invalid_argument("ImuPreintegration: the linearisation biases must be finite");
-  }
+    : ImuPreintegration(BiasesOnly(bg_lin_radps, ba_lin_mps2), gyro_arw_rad_per_sqrt_s, accel_vrw_mps_per_sqrt_s) {}
+
+ImuPreintegration::ImuPreintegration(const ImuErrors& lin, double gyro_arw_rad_per_sqrt_s,
+                                     double accel_vrw_mps_per_sqrt_s)
+    : lin_(lin), gyro_arw_(gyro_arw_rad_per_sqrt_s), accel_vrw_(accel_vrw_mps_per_sqrt_s) {
+  CheckLinearisation(lin, "ImuPreintegration");
   if (!(gyro_arw_ > 0.0) || !std::isfinite(gyro_arw_)) {
     throw std::invalid_argument("ImuPreintegration: gyro ARW must be positive and finite");
   }
@@ -168,6 +226,8 @@ void ImuPreintegration::Reset() {
   covariance_.setZero();
   J_bg_.setZero();
   J_ba_.setZero();
+  J_sg_.setZero();
+  J_sa_.setZero();
 }
 
 double ImuPreintegration::t_start_s() const {
@@ -202,16 +262,21 @@ void ImuPreintegration::Integrate(const ImuSample& s) {
 
 void ImuPreintegration::Reintegrate(const Eigen::Vector3d& bg_lin_radps,
                                     const Eigen::Vector3d& ba_lin_mps2) {
-  if (!bg_lin_radps.allFinite() || !ba_lin_mps2.allFinite()) {
-    throw std::invalid_argument("ImuPreintegration::Reintegrate: biases must be finite");
-  }
-  bg_lin_ = bg_lin_radps;
-  ba_lin_ = ba_lin_mps2;
+  ImuErrors lin = lin_;
+  lin.bg_radps = bg_lin_radps;
+  lin.ba_mps2 = ba_lin_mps2;
+  Reintegrate(lin);
+}
+
+void ImuPreintegration::Reintegrate(const ImuErrors& lin) {
+  CheckLinearisation(lin, "ImuPreintegration::Reintegrate");
+  lin_ = lin;
   Reset();
   for (const ImuSample& s : samples_) Propagate(s);
 }
 
-// One sample, bias-corrected a = dtheta - bg dt, u = dv - ba dt (docs/imu-preintegration.md).
+// One sample, corrected a = D_g (dtheta - bg dt), u = D_a (dv - ba dt) with D_g = diag(1 / (1 + sg)),
+// D_a = diag(1 / (1 + sa)) (core/imu_errors.h; docs/imu-preintegration.md).
 // Error propagation, x = (dphi, dv, dp), noise n_g on a, n_a on u:
 //   x_k = A x_{k-1} + B_g n_g + B_a n_a
 //   A   = [ Exp(a)^T       0     0 ]      B_g = [ J_r(a)                  ]
@@ -219,8 +284,13 @@ void ImuPreintegration::Reintegrate(const Eigen::Vector3d& bg_lin_radps,
 //         [ -dR [s]x dt    I dt  I ]            [ -1/6 dR [u]x dt         ]
 //   B_a = [ 0; dR (I + 1/2 [a]x); dR (1/2 I + 1/6 [a]x) dt ],
 //   w = u + 1/2 a x u,  s = 1/2 u + 1/6 a x u,  dR = dR_{k-1}.
-// A bias change db is the noise -db dt, so J_bg <- A J_bg - B_g dt, J_ba <- A J_ba - B_a dt
-// (exact derivatives of the discrete recursion). The covariance uses B_g with
+// A bias change dbg changes a by -D_g dbg dt, a scale-factor change dsg by -D_g diag(a) dsg
+// (d/ds of x / (1 + s) is -x / (1 + s)^2), likewise for u, so
+//   J_bg <- A J_bg - B_g D_g dt,        J_ba <- A J_ba - B_a D_a dt,
+//   J_sg <- A J_sg - B_g D_g diag(a),   J_sa <- A J_sa - B_a D_a diag(u)
+// (exact derivatives of the discrete recursion). The noise densities are taken for the
+// corrected sample (the D_g^2 on the raw noise is 1 - 2 sg, 0.4 % for 2000 ppm, left out).
+// The covariance uses B_g with
 // var(n_g) = ARW^2 dt I, and for the accelerometer the continuous-time integral of white
 // noise over the sample, rotated by dR (isotropic, so the rotation drops out):
 //   cov(dv, dv) = VRW^2 dt I, cov(dv, dp) = VRW^2 dt^2/2 I, cov(dp, dp) = VRW^2 dt^3/3 I
@@ -228,8 +298,11 @@ void ImuPreintegration::Reintegrate(const Eigen::Vector3d& bg_lin_radps,
 // covariance).
 void ImuPreintegration::Propagate(const ImuSample& sample) {
   const double dt = sample.dt_s;
-  const Eigen::Vector3d a = sample.dtheta_b_rad - bg_lin_ * dt;
-  const Eigen::Vector3d u = sample.dv_b_mps - ba_lin_ * dt;
+  const ImuSample corrected = CorrectImu(sample, lin_);
+  const Eigen::Vector3d& a = corrected.dtheta_b_rad;
+  const Eigen::Vector3d& u = corrected.dv_b_mps;
+  const Eigen::Vector3d Dg = (Eigen::Vector3d::Ones() + lin_.sg).cwiseInverse();
+  const Eigen::Vector3d Da = (Eigen::Vector3d::Ones() + lin_.sa).cwiseInverse();
   const Eigen::Matrix3d& dR = delta_R_;  // dR_{k-1}
   const Eigen::Vector3d w = u + 0.5 * a.cross(u);
   const Eigen::Vector3d s = 0.5 * u + a.cross(u) / 6.0;
@@ -250,8 +323,10 @@ void ImuPreintegration::Propagate(const ImuSample& sample) {
   B_a.block<3, 3>(3, 0) = dR * (I3 + 0.5 * Skew<double>(a));
   B_a.block<3, 3>(6, 0) = dR * (0.5 * I3 + Skew<double>(a) / 6.0) * dt;
 
-  J_bg_ = A * J_bg_ - B_g * dt;
-  J_ba_ = A * J_ba_ - B_a * dt;
+  J_bg_ = A * J_bg_ - B_g * (Dg * dt).asDiagonal();
+  J_ba_ = A * J_ba_ - B_a * (Da * dt).asDiagonal();
+  J_sg_ = A * J_sg_ - B_g * Dg.cwiseProduct(a).asDiagonal();
+  J_sa_ = A * J_sa_ - B_a * Da.cwiseProduct(u).asDiagonal();
 
   Matrix9d Q = gyro_arw_ * gyro_arw_ * dt * B_g * B_g.transpose();
   const double qa = accel_vrw_ * accel_vrw_;
@@ -281,11 +356,19 @@ ImuPreintegration::Matrix9d ImuPreintegration::SqrtInformation() const {
 
 ImuPreintegration::Deltas ImuPreintegration::Corrected(const Eigen::Vector3d& bg_radps,
                                                        const Eigen::Vector3d& ba_mps2) const {
-  const Eigen::Vector3d dbg = bg_radps - bg_lin_, dba = ba_mps2 - ba_lin_;
+  ImuErrors e = lin_;
+  e.bg_radps = bg_radps;
+  e.ba_mps2 = ba_mps2;
+  return Corrected(e);
+}
+
+ImuPreintegration::Deltas ImuPreintegration::Corrected(const ImuErrors& e) const {
+  const Eigen::Vector3d dbg = e.bg_radps - lin_.bg_radps, dba = e.ba_mps2 - lin_.ba_mps2;
+  const Eigen::Vector3d dsg = e.sg - lin_.sg, dsa = e.sa - lin_.sa;
   Deltas d;
-  d.delta_q = (delta_q_ * QuatFromRotVec<double>(J_R_bg() * dbg)).normalized();
-  d.delta_v_mps = delta_v_ + J_v_bg() * dbg + J_v_ba() * dba;
-  d.delta_p_m = delta_p_ + J_p_bg() * dbg + J_p_ba() * dba;
+  d.delta_q = (delta_q_ * QuatFromRotVec<double>(J_R_bg() * dbg + J_R_sg() * dsg)).normalized();
+  d.delta_v_mps = delta_v_ + J_v_bg() * dbg + J_v_ba() * dba + J_v_sg() * dsg + J_v_sa() * dsa;
+  d.delta_p_m = delta_p_ + J_p_bg() * dbg + J_p_ba() * dba + J_p_sg() * dsg + J_p_sa() * dsa;
   return d;
 }
 
@@ -293,6 +376,12 @@ ceres::CostFunction* CreateImuFactor(std::shared_ptr<const ImuPreintegration> pr
   if (!pre) throw std::invalid_argument("CreateImuFactor: null preintegration");
   return new ceres::AutoDiffCostFunction<ImuFactor, 9, 3, 3, 4, 3, 3, 3, 3, 4>(
       new ImuFactor(MakeData(*pre, /*whiten=*/true)));
+}
+
+ceres::CostFunction* CreateImuScaleFactor(std::shared_ptr<const ImuPreintegration> pre) {
+  if (!pre) throw std::invalid_argument("CreateImuScaleFactor: null preintegration");
+  return new ceres::AutoDiffCostFunction<ImuScaleFactor, 9, 3, 3, 4, 3, 3, 3, 3, 3, 3, 4>(
+      new ImuScaleFactor(MakeData(*pre, /*whiten=*/true)));
 }
 
 Eigen::Matrix<double, 9, 1> ImuFactorResidual(const ImuPreintegration& pre, const double* pos_i,
@@ -303,6 +392,17 @@ Eigen::Matrix<double, 9, 1> ImuFactorResidual(const ImuPreintegration& pre, cons
   const ImuFactor factor(MakeData(pre, whitened));
   Eigen::Matrix<double, 9, 1> r;
   factor(pos_i, vel_i, q_i, bg_i, ba_i, pos_j, vel_j, q_j, r.data());
+  return r;
+}
+
+Eigen::Matrix<double, 9, 1> ImuScaleFactorResidual(const ImuPreintegration& pre, const double* pos_i,
+                                                   const double* vel_i, const double* q_i, const double* bg_i,
+                                                   const double* ba_i, const double* sg_i, const double* sa_i,
+                                                   const double* pos_j, const double* vel_j, const double* q_j,
+                                                   bool whitened) {
+  const ImuFactor factor(MakeData(pre, whitened));
+  Eigen::Matrix<double, 9, 1> r;
+  factor.Evaluate(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, pos_j, vel_j, q_j, r.data());
   return r;
 }
 

@@ -13,13 +13,12 @@
 //   [18,21)  dsa          accelerometer scale-factor error             21-state filter only
 //
 // IMU error model (per axis, in the IMU axes after the mounting rotation into body FRD):
-//   omega_meas = (1 + sg) omega_true + bg + noise,   f_meas = (1 + sa) f_true + ba + noise
-// so a sample is corrected as  dtheta_c = (dtheta - bg dt) / (1 + sg),
-//                              dv_c     = (dv - ba dt) / (1 + sa).
+// core/imu_errors.h.
 #pragma once
 
 #include <Eigen/Core>
 
+#include "core/imu_errors.h"
 #include "core/types.h"
 
 namespace navtwin::ins {
@@ -41,27 +40,14 @@ constexpr int kSize15 = 15;
 constexpr int kSize21 = 21;
 }  // namespace err
 
-/// Estimated IMU errors (body FRD axes, after the mounting rotation).
-struct ImuErrors {
-  Eigen::Vector3d bg_radps = Eigen::Vector3d::Zero();
-  Eigen::Vector3d ba_mps2 = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sg = Eigen::Vector3d::Zero();  ///< gyro scale-factor errors (dimensionless)
-  Eigen::Vector3d sa = Eigen::Vector3d::Zero();  ///< accelerometer scale-factor errors
-};
+using ::navtwin::CorrectImu;
+using ::navtwin::ImuErrors;
 
 /// Navigation state (at the IMU) plus the IMU errors.
 struct InsState {
   NavState nav;
   ImuErrors imu;
 };
-
-/// An IMU sample corrected for the estimated errors: (dtheta - bg dt) / (1 + sg), etc.
-inline ImuSample CorrectImu(const ImuSample& raw, const ImuErrors& e) {
-  ImuSample c = raw;
-  c.dtheta_b_rad = (raw.dtheta_b_rad - e.bg_radps * raw.dt_s).cwiseQuotient(Eigen::Vector3d::Ones() + e.sg);
-  c.dv_b_mps = (raw.dv_b_mps - e.ba_mps2 * raw.dt_s).cwiseQuotient(Eigen::Vector3d::Ones() + e.sa);
-  return c;
-}
 
 /// A state of a solution with the standard deviations of its error state (15 or 21
 /// entries, the layout above; empty when not computed). Units: m, m/s, rad, rad/s, m/s^2, -.

@@ -1,7 +1,7 @@
 // ImuPreintegration and its factor: (1) residual at the true states of error-free
 // trajectories (static; 15 m/s and 250 m/s turning, accelerating, climbing flight) with
-// jittered sample intervals and states between samples; (2) bias Jacobians against
-// Reintegrate (central differences) and the factor's bias correction; (3) the autodiff
+// jittered sample intervals and states between samples; (2) bias and scale-factor
+// Jacobians against Reintegrate (central differences) and the factor's corrections; (3) the autodiff
 // Jacobian against central differences in the tangent spaces; (4) the covariance and the
 // whitening against a Monte Carlo of noisy increments. Figures: docs/imu-preintegration.md.
 #include "factors/imu_preintegration.h"
@@ -138,10 +138,9 @@ Record MakeRecord(const sim::AnalyticTrajectory& trajectory, double duration_s, 
 }
 
 /// Preintegrates the samples over [t_i, t_j], splitting the samples that straddle t_i or t_j.
-std::shared_ptr<ImuPreintegration> Preintegrate(const std::vector<ImuSample>& imu, double t_i,
-                                                double t_j, const Eigen::Vector3d& bg,
-                                                const Eigen::Vector3d& ba, double arw, double vrw) {
-  auto pre = std::make_shared<ImuPreintegration>(bg, ba, arw, vrw);
+std::shared_ptr<ImuPreintegration> Preintegrate(const std::vector<ImuSample>& imu, double t_i, double t_j,
+                                                const ImuErrors& lin, double arw, double vrw) {
+  auto pre = std::make_shared<ImuPreintegration>(lin, arw, vrw);
   constexpr double kEps = 1e-9;  // time-tag comparison (tags are multiples of 1 ms)
   for (ImuSample s : imu) {
     const double t0 = s.t_s - s.dt_s;
@@ -151,6 +150,15 @@ std::shared_ptr<ImuPreintegration> Preintegrate(const std::vector<ImuSample>& im
     pre->Integrate(s);
   }
   return pre;
+}
+
+std::shared_ptr<ImuPreintegration> Preintegrate(const std::vector<ImuSample>& imu, double t_i,
+                                                double t_j, const Eigen::Vector3d& bg,
+                                                const Eigen::Vector3d& ba, double arw, double vrw) {
+  ImuErrors lin;
+  lin.bg_radps = bg;
+  lin.ba_mps2 = ba;
+  return Preintegrate(imu, t_i, t_j, lin, arw, vrw);
 }
 
 /// A state as the factor's parameter blocks.
@@ -298,6 +306,126 @@ TEST(ImuPreintegration, BiasJacobiansMatchReintegration) {
   EXPECT_LT(num_R_ba.norm(), 1e-12);  // the rotation does not depend on ba
 }
 
+// The scale-factor Jacobians, and the bias Jacobians at non-zero scale factors (where the
+// bias enters divided by 1 + s), against central differences of Reintegrate. Steps 1e-5:
+// truncation h^2 |d3/ds3| / 6 with |d3 dv/ds3| ~ 6 |dv| < 200 gives 3e-9, rounding
+// eps |dv| / h < 1e-9, against Jacobians of O(1 .. 30).
+TEST(ImuPreintegration, ScaleFactorJacobiansMatchReintegration) {
+  const Record rec = MakeRecord(Flight(kFast), 4.0);
+  ImuErrors lin;
+  lin.bg_radps = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+  lin.ba_mps2 = Eigen::Vector3d(0.02, -0.01, 0.03);
+  lin.sg = Eigen::Vector3d(1500e-6, -800e-6, 2000e-6);
+  lin.sa = Eigen::Vector3d(-1200e-6, 900e-6, 3000e-6);
+  const auto pre = Preintegrate(rec.imu, 2.0, 3.0, lin, kArw, kVrw);
+  using Member = Eigen::Vector3d ImuErrors::*;
+  // Central differences of (rotation, velocity, position) in one member of the errors.
+  const auto numeric = [&](Member member, double h) {
+    Eigen::Matrix<double, 9, 3> J;
+    for (int k = 0; k < 3; ++k) {
+      ImuErrors up = lin, down = lin;
+      (up.*member)[k] += h;
+      (down.*member)[k] -= h;
+      ImuPreintegration plus = *pre, minus = *pre;
+      plus.Reintegrate(up);
+      minus.Reintegrate(down);
+      J.block<3, 1>(0, k) = (LogSO3<double>(pre->delta_R().transpose() * plus.delta_R()) -
+                             LogSO3<double>(pre->delta_R().transpose() * minus.delta_R())) / (2 * h);
+      J.block<3, 1>(3, k) = (plus.delta_v_mps() - minus.delta_v_mps()) / (2 * h);
+      J.block<3, 1>(6, k) = (plus.delta_p_m() - minus.delta_p_m()) / (2 * h);
+    }
+    return J;
+  };
+  const auto expect_close = [](const Eigen::Matrix3d& analytic, const Eigen::Matrix3d& numeric_J, const char* what) {
+    std::printf("  %s: |analytic - numeric| / |numeric| = %.1e\n", what,
+                (analytic - numeric_J).norm() / numeric_J.norm());
+    EXPECT_LT((analytic - numeric_J).norm(), 1e-7 * std::max(1.0, numeric_J.norm()))
+        << what << "\nanalytic\n" << analytic << "\nnumeric\n" << numeric_J;
+  };
+  const Eigen::Matrix<double, 9, 3> sg = numeric(&ImuErrors::sg, 1e-5), sa = numeric(&ImuErrors::sa, 1e-5);
+  const Eigen::Matrix<double, 9, 3> bg = numeric(&ImuErrors::bg_radps, 1e-5);
+  const Eigen::Matrix<double, 9, 3> ba = numeric(&ImuErrors::ba_mps2, 1e-4);
+  expect_close(pre->J_R_sg(), sg.block<3, 3>(0, 0), "J_R_sg");
+  expect_close(pre->J_v_sg(), sg.block<3, 3>(3, 0), "J_v_sg");
+  expect_close(pre->J_p_sg(), sg.block<3, 3>(6, 0), "J_p_sg");
+  expect_close(pre->J_v_sa(), sa.block<3, 3>(3, 0), "J_v_sa");
+  expect_close(pre->J_p_sa(), sa.block<3, 3>(6, 0), "J_p_sa");
+  EXPECT_LT(sa.topRows<3>().norm(), 1e-12);  // the rotation does not depend on sa
+  expect_close(pre->J_R_bg(), bg.block<3, 3>(0, 0), "J_R_bg at s != 0");
+  expect_close(pre->J_v_bg(), bg.block<3, 3>(3, 0), "J_v_bg at s != 0");
+  expect_close(pre->J_p_bg(), bg.block<3, 3>(6, 0), "J_p_bg at s != 0");
+  expect_close(pre->J_v_ba(), ba.block<3, 3>(3, 0), "J_v_ba at s != 0");
+  expect_close(pre->J_p_ba(), ba.block<3, 3>(6, 0), "J_p_ba at s != 0");
+  // The scale factors' effect is large enough that the check means something: 2000 ppm of
+  // a 1 s turn at 0.46 rad/s is about 1e-3 rad, of 30 m/s^2 for 1 s 0.06 m/s.
+  EXPECT_GT(pre->J_R_sg().norm(), 0.1);
+  EXPECT_GT(pre->J_v_sa().norm(), 10.0);
+}
+
+// Samples with 2000 ppm scale-factor errors (and biases), preintegrated at zero errors.
+struct ScaleCorrection {
+  Eigen::Matrix<double, 9, 1> uncorrected, corrected;  ///< residuals at the true states, s = 0 and s true
+  double remainder_rad = 0.0, remainder_mps = 0.0;     ///< Corrected() against Reintegrate
+};
+
+ScaleCorrection CorrectScaleFactors(const Record& rec, double fraction) {
+  ImuErrors truth;
+  truth.bg_radps = Eigen::Vector3d(2e-4, -3e-4, 1e-4) * fraction;
+  truth.ba_mps2 = Eigen::Vector3d(0.05, -0.03, 0.08) * fraction;
+  truth.sg = Eigen::Vector3d(2000e-6, -2000e-6, 2000e-6) * fraction;
+  truth.sa = Eigen::Vector3d(-2000e-6, 2000e-6, 2000e-6) * fraction;
+  std::vector<ImuSample> measured = rec.imu;
+  for (ImuSample& s : measured) {  // omega_meas = (1 + sg) omega + bg (core/imu_errors.h)
+    s.dtheta_b_rad = (Eigen::Vector3d::Ones() + truth.sg).cwiseProduct(s.dtheta_b_rad) + truth.bg_radps * s.dt_s;
+    s.dv_b_mps = (Eigen::Vector3d::Ones() + truth.sa).cwiseProduct(s.dv_b_mps) + truth.ba_mps2 * s.dt_s;
+  }
+  const auto pre = Preintegrate(measured, 2.0, 3.0, ImuErrors{}, kArw, kVrw);
+  const Blocks i = ToBlocks(rec.truth[2000], truth.bg_radps, truth.ba_mps2), j = ToBlocks(rec.truth[3000]);
+  double sg[3], sa[3], zero[3] = {0.0, 0.0, 0.0};
+  Eigen::Map<Eigen::Vector3d>{sg} = truth.sg;
+  Eigen::Map<Eigen::Vector3d>{sa} = truth.sa;
+  ScaleCorrection c;
+  c.corrected = ImuScaleFactorResidual(*pre, i.pos, i.vel, i.q, i.bg, i.ba, sg, sa, j.pos, j.vel, j.q, false);
+  c.uncorrected = ImuScaleFactorResidual(*pre, i.pos, i.vel, i.q, i.bg, i.ba, zero, zero, j.pos, j.vel, j.q, false);
+  ImuPreintegration re = *pre;
+  re.Reintegrate(truth);
+  const ImuPreintegration::Deltas d = pre->Corrected(truth);
+  c.remainder_rad = AttitudeError<double>(d.delta_q, re.delta_q()).norm();
+  c.remainder_mps = (d.delta_v_mps - re.delta_v_mps()).norm();
+  return c;
+}
+
+// The factor at the true scale factors and biases leaves the second-order remainder of the
+// first-order correction; at zero scale factors it leaves their whole effect. The remainder
+// is shown to be second order: it shrinks four times when the errors are halved.
+TEST(ImuPreintegration, FactorCorrectsScaleFactorsToFirstOrder) {
+  const Record rec = MakeRecord(Flight(kFast), 4.0);
+  const ScaleCorrection full = CorrectScaleFactors(rec, 1.0), half = CorrectScaleFactors(rec, 0.5);
+  std::printf("  uncorrected %.2e rad %.2e m/s %.2e m, corrected %.2e rad %.2e m/s %.2e m\n",
+              full.uncorrected.segment<3>(0).norm(), full.uncorrected.segment<3>(3).norm(),
+              full.uncorrected.segment<3>(6).norm(), full.corrected.segment<3>(0).norm(),
+              full.corrected.segment<3>(3).norm(), full.corrected.segment<3>(6).norm());
+  std::printf("  remainder of the first-order correction: %.2e rad %.2e m/s; at half the errors %.2e rad %.2e m/s\n",
+              full.remainder_rad, full.remainder_mps, half.remainder_rad, half.remainder_mps);
+  // Uncorrected: 2000 ppm of the 1 s rotation (0.46 rad) and velocity change (|f| <= 30 m/s^2).
+  EXPECT_GT(full.uncorrected.segment<3>(0).norm(), 2e-4);
+  EXPECT_GT(full.uncorrected.segment<3>(3).norm(), 0.01);
+  // The remainder is second order (ratio 4 for halved errors; 3..5 leaves room for the
+  // third-order terms), and small against the effect it corrects (below 1 %).
+  EXPECT_GT(full.remainder_rad / half.remainder_rad, 3.0);
+  EXPECT_LT(full.remainder_rad / half.remainder_rad, 5.0);
+  EXPECT_GT(full.remainder_mps / half.remainder_mps, 3.0);
+  EXPECT_LT(full.remainder_mps / half.remainder_mps, 5.0);
+  EXPECT_LT(full.remainder_rad, 0.01 * full.uncorrected.segment<3>(0).norm());
+  EXPECT_LT(full.remainder_mps, 0.01 * full.uncorrected.segment<3>(3).norm());
+  // Corrected: that remainder on top of test (1)'s budget for the 250 m/s flight without
+  // split samples (5e-7 rad, 7.5e-5 m/s, 2.9e-4 m); the position remainder is at most the
+  // velocity one integrated over the 1 s interval.
+  EXPECT_LT(full.corrected.segment<3>(0).norm(), 5e-7 + full.remainder_rad);
+  EXPECT_LT(full.corrected.segment<3>(3).norm(), 7.5e-5 + full.remainder_mps);
+  EXPECT_LT(full.corrected.segment<3>(6).norm(), 2.9e-4 + full.remainder_mps);
+}
+
 TEST(ImuPreintegration, FactorCorrectsBiasToFirstOrder) {
   const Record rec = MakeRecord(Flight(kFast), 4.0);
   const Eigen::Vector3d bg(2e-4, -3e-4, 1e-4), ba(0.05, -0.03, 0.08);  // 40..60 deg/h, 3..8 mg
@@ -344,58 +472,32 @@ TEST(ImuPreintegration, FactorCorrectsBiasToFirstOrder) {
 // ---------------------------------------------------------------------------------------
 // (3) The autodiff Jacobian in the tangent spaces against central differences.
 
-TEST(ImuPreintegration, FactorJacobianMatchesCentralDifferences) {
-  const Record rec = MakeRecord(Flight(kFast), 12.0);
-  const Eigen::Vector3d bg0(1e-3, -2e-3, 5e-4), ba0(0.02, -0.01, 0.03);
-  const auto pre = Preintegrate(rec.imu, 10.003, 11.003, bg0, ba0, kArw, kVrw);
-  const std::unique_ptr<ceres::CostFunction> cost(CreateImuFactor(pre));
-  ASSERT_EQ(cost->num_residuals(), 9);
-  ASSERT_EQ(cost->parameter_block_sizes(), (std::vector<int32_t>{3, 3, 4, 3, 3, 3, 3, 4}));
-
-  // A point away from the solution (whitened residuals O(10..1e3)).
-  Blocks i = ToBlocks(rec.truth[10003], bg0 + Eigen::Vector3d(1e-4, 2e-4, -1e-4),
-                      ba0 + Eigen::Vector3d(0.01, -0.02, 0.01));
-  Blocks j = ToBlocks(rec.truth[11003]);
-  const double dp_i[3] = {0.7, -1.2, 0.4}, dp_j[3] = {-0.3, 0.5, 1.1};
-  const PositionManifold pos_manifold;
-  const AttitudeManifold att_manifold;
-  double tmp[4];
-  PositionPlus(i.pos, dp_i, tmp);
-  std::copy(tmp, tmp + 3, i.pos);
-  PositionPlus(j.pos, dp_j, tmp);
-  std::copy(tmp, tmp + 3, j.pos);
-  Eigen::Map<Eigen::Vector3d>(i.vel) += Eigen::Vector3d(0.1, -0.05, 0.02);
-  Eigen::Map<Eigen::Vector4d>(i.q) =
-      ApplyAttitudeError<double>(Eigen::Vector3d(0.01, -0.02, 0.005), Eigen::Map<Eigen::Quaterniond>(i.q)).coeffs();
-  Eigen::Map<Eigen::Vector4d>(j.q) =
-      ApplyAttitudeError<double>(Eigen::Vector3d(-0.004, 0.01, 0.02), Eigen::Map<Eigen::Quaterniond>(j.q)).coeffs();
-
-  std::vector<double*> blocks = {i.pos, i.vel, i.q, i.bg, i.ba, j.pos, j.vel, j.q};
-  const std::vector<const ceres::Manifold*> manifolds = {&pos_manifold, nullptr, &att_manifold, nullptr,
-                                                         nullptr, &pos_manifold, nullptr, &att_manifold};
-  // Steps per block: 1e-3 m, 1e-4 m/s, 1e-6 rad, 1e-6 rad/s, 1e-5 m/s^2 (whitened changes
-  // of 1e-3 .. 1e-2). Truncation h^2 |r'''| / 6 and rounding eps |r| / h are < 1e-8 relative
-  // to the block's Jacobian norm; a position step is rounded to the ulp of lat/lon
-  // (1e-16 rad = 0.7 nm, 7e-7 of the 1 mm step): tolerance 1e-6 relative.
-  const double steps[8] = {1e-3, 1e-4, 1e-6, 1e-6, 1e-5, 1e-3, 1e-4, 1e-6};
-
+/// The cost's Jacobian (autodiff, mapped to the tangent spaces by the manifolds' PlusJacobian)
+/// against central differences with the given step per block, at `blocks` (which it
+/// perturbs and restores): each block within 1e-6 of its norm.
+void ExpectJacobianMatchesCentralDifferences(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
+                                             const std::vector<const ceres::Manifold*>& manifolds,
+                                             const std::vector<double>& steps) {
+  ASSERT_EQ(blocks.size(), manifolds.size());
+  ASSERT_EQ(blocks.size(), steps.size());
   const auto evaluate = [&](const std::vector<double*>& b, double** jac) {
     Eigen::Matrix<double, 9, 1> r;
-    EXPECT_TRUE(cost->Evaluate(b.data(), r.data(), jac));
+    EXPECT_TRUE(cost.Evaluate(b.data(), r.data(), jac));
     return r;
   };
   // Ceres fills row-major 9 x size(block) arrays.
-  std::vector<double*> jac_ptrs(8);
-  std::vector<std::vector<double>> jac_storage(8);
-  for (int b = 0; b < 8; ++b) {
-    jac_storage[b].resize(9 * cost->parameter_block_sizes()[b]);
+  const int num_blocks = static_cast<int>(blocks.size());
+  std::vector<double*> jac_ptrs(blocks.size());
+  std::vector<std::vector<double>> jac_storage(blocks.size());
+  for (int b = 0; b < num_blocks; ++b) {
+    jac_storage[b].resize(9 * cost.parameter_block_sizes()[b]);
     jac_ptrs[b] = jac_storage[b].data();
   }
   const Eigen::Matrix<double, 9, 1> r0 = evaluate(blocks, jac_ptrs.data());
   EXPECT_GT(r0.norm(), 10.0);
 
-  for (int b = 0; b < 8; ++b) {
-    const int n = cost->parameter_block_sizes()[b];
+  for (int b = 0; b < num_blocks; ++b) {
+    const int n = cost.parameter_block_sizes()[b];
     const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J_amb(
         jac_storage[b].data(), 9, n);
     Eigen::MatrixXd J_tan(9, 3);
@@ -430,6 +532,79 @@ TEST(ImuPreintegration, FactorJacobianMatchesCentralDifferences) {
         << "block " << b << "\nautodiff\n" << J_tan << "\nnumeric\n" << J_num;
   }
 }
+
+TEST(ImuPreintegration, FactorJacobianMatchesCentralDifferences) {
+  const Record rec = MakeRecord(Flight(kFast), 12.0);
+  const Eigen::Vector3d bg0(1e-3, -2e-3, 5e-4), ba0(0.02, -0.01, 0.03);
+  const auto pre = Preintegrate(rec.imu, 10.003, 11.003, bg0, ba0, kArw, kVrw);
+  const std::unique_ptr<ceres::CostFunction> cost(CreateImuFactor(pre));
+  ASSERT_EQ(cost->num_residuals(), 9);
+  ASSERT_EQ(cost->parameter_block_sizes(), (std::vector<int32_t>{3, 3, 4, 3, 3, 3, 3, 4}));
+
+  // A point away from the solution (whitened residuals O(10..1e3)).
+  Blocks i = ToBlocks(rec.truth[10003], bg0 + Eigen::Vector3d(1e-4, 2e-4, -1e-4),
+                      ba0 + Eigen::Vector3d(0.01, -0.02, 0.01));
+  Blocks j = ToBlocks(rec.truth[11003]);
+  const double dp_i[3] = {0.7, -1.2, 0.4}, dp_j[3] = {-0.3, 0.5, 1.1};
+  const PositionManifold pos_manifold;
+  const AttitudeManifold att_manifold;
+  double tmp[4];
+  PositionPlus(i.pos, dp_i, tmp);
+  std::copy(tmp, tmp + 3, i.pos);
+  PositionPlus(j.pos, dp_j, tmp);
+  std::copy(tmp, tmp + 3, j.pos);
+  Eigen::Map<Eigen::Vector3d>(i.vel) += Eigen::Vector3d(0.1, -0.05, 0.02);
+  Eigen::Map<Eigen::Vector4d>(i.q) =
+      ApplyAttitudeError<double>(Eigen::Vector3d(0.01, -0.02, 0.005), Eigen::Map<Eigen::Quaterniond>(i.q)).coeffs();
+  Eigen::Map<Eigen::Vector4d>(j.q) =
+      ApplyAttitudeError<double>(Eigen::Vector3d(-0.004, 0.01, 0.02), Eigen::Map<Eigen::Quaterniond>(j.q)).coeffs();
+
+  std::vector<double*> blocks = {i.pos, i.vel, i.q, i.bg, i.ba, j.pos, j.vel, j.q};
+  const std::vector<const ceres::Manifold*> manifolds = {&pos_manifold, nullptr, &att_manifold, nullptr,
+                                                         nullptr, &pos_manifold, nullptr, &att_manifold};
+  // Steps per block: 1e-3 m, 1e-4 m/s, 1e-6 rad, 1e-6 rad/s, 1e-5 m/s^2 (whitened changes
+  // of 1e-3 .. 1e-2). Truncation h^2 |r'''| / 6 and rounding eps |r| / h are < 1e-8 relative
+  // to the block's Jacobian norm; a position step is rounded to the ulp of lat/lon
+  // (1e-16 rad = 0.7 nm, 7e-7 of the 1 mm step): tolerance 1e-6 relative.
+  ExpectJacobianMatchesCentralDifferences(*cost, blocks, manifolds, {1e-3, 1e-4, 1e-6, 1e-6, 1e-5, 1e-3, 1e-4, 1e-6});
+}
+
+// The same for the factor with scale-factor blocks, linearised at non-zero scale factors and
+// evaluated at others (steps 1e-6 on the scale factors: whitened changes of 1e-3).
+TEST(ImuPreintegration, ScaleFactorJacobianMatchesCentralDifferences) {
+  const Record rec = MakeRecord(Flight(kFast), 12.0);
+  ImuErrors lin;
+  lin.bg_radps = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+  lin.ba_mps2 = Eigen::Vector3d(0.02, -0.01, 0.03);
+  lin.sg = Eigen::Vector3d(1500e-6, -800e-6, 2000e-6);
+  lin.sa = Eigen::Vector3d(-1200e-6, 900e-6, 3000e-6);
+  const auto pre = Preintegrate(rec.imu, 10.003, 11.003, lin, kArw, kVrw);
+  const std::unique_ptr<ceres::CostFunction> cost(CreateImuScaleFactor(pre));
+  ASSERT_EQ(cost->num_residuals(), 9);
+  ASSERT_EQ(cost->parameter_block_sizes(), (std::vector<int32_t>{3, 3, 4, 3, 3, 3, 3, 3, 3, 4}));
+  Blocks i = ToBlocks(rec.truth[10003], lin.bg_radps + Eigen::Vector3d(1e-4, 2e-4, -1e-4),
+                      lin.ba_mps2 + Eigen::Vector3d(0.01, -0.02, 0.01));
+  Blocks j = ToBlocks(rec.truth[11003]);
+  Eigen::Map<Eigen::Vector3d>(i.vel) += Eigen::Vector3d(0.1, -0.05, 0.02);
+  Eigen::Map<Eigen::Vector4d>(i.q) =
+      ApplyAttitudeError<double>(Eigen::Vector3d(0.01, -0.02, 0.005), Eigen::Map<Eigen::Quaterniond>(i.q)).coeffs();
+  double sg[3] = {1000e-6, -500e-6, 2500e-6}, sa[3] = {-1000e-6, 1500e-6, 2000e-6};
+  const PositionManifold pos_manifold;
+  const AttitudeManifold att_manifold;
+  std::vector<double*> blocks = {i.pos, i.vel, i.q, i.bg, i.ba, sg, sa, j.pos, j.vel, j.q};
+  const std::vector<const ceres::Manifold*> manifolds = {
+      &pos_manifold, nullptr, &att_manifold, nullptr, nullptr, nullptr, nullptr, &pos_manifold, nullptr, &att_manifold};
+  ExpectJacobianMatchesCentralDifferences(*cost, blocks, manifolds,
+                                          {1e-3, 1e-4, 1e-6, 1e-6, 1e-5, 1e-6, 1e-6, 1e-3, 1e-4, 1e-6});
+  // At the linearisation point's scale factors it is the factor without them.
+  double sg_lin[3], sa_lin[3];
+  Eigen::Map<Eigen::Vector3d>{sg_lin} = lin.sg;
+  Eigen::Map<Eigen::Vector3d>{sa_lin} = lin.sa;
+  const Eigen::Matrix<double, 9, 1> with =
+      ImuScaleFactorResidual(*pre, i.pos, i.vel, i.q, i.bg, i.ba, sg_lin, sa_lin, j.pos, j.vel, j.q, true);
+  EXPECT_LT((with - Residual(*pre, i, j, true)).norm(), 1e-12 * with.norm());
+}
+
 
 TEST(ImuPreintegration, CeresRecoversStateJ) {
   // State i and the biases held, state j started 5 m, 0.5 m/s and 0.05 rad off: the factor
@@ -567,6 +742,10 @@ TEST(ImuPreintegration, RejectsBadInput) {
   EXPECT_THROW(ImuPreintegration(z, z, 0.0, kVrw), std::invalid_argument);
   EXPECT_THROW(ImuPreintegration(z, z, kArw, -1.0), std::invalid_argument);
   EXPECT_THROW(ImuPreintegration(z, z, kArw, std::nan("")), std::invalid_argument);
+  ImuErrors bad_scale;
+  bad_scale.sa.x() = -1.0;  // 1 + s = 0
+  EXPECT_THROW(ImuPreintegration(bad_scale, kArw, kVrw), std::invalid_argument);
+  EXPECT_THROW(CreateImuScaleFactor(nullptr), std::invalid_argument);
   EXPECT_THROW(ImuPreintegration(Eigen::Vector3d::Constant(std::nan("")), z, kArw, kVrw),
                std::invalid_argument);
   auto pre = std::make_shared<ImuPreintegration>(z, z, kArw, kVrw);
