@@ -128,6 +128,25 @@ double KnotTiltVariance(const NavEpoch& knot) {
   return std::isfinite(v) ? v : 0.0;
 }
 
+/// The IMU errors the batch carries per state: the biases always, the scale factors with
+/// config.filter.scale_factors (the 21-state model). Each kind is a Gauss-Markov process
+/// over the states or, with no process noise, one block shared by all states.
+enum ImuErrorKind { kGyroBias, kAccelBias, kGyroScale, kAccelScale, kImuErrorKinds };
+
+struct ImuErrorKindInfo {
+  Eigen::Vector3d ImuErrors::*member;
+  int err_index;           ///< in the error state (ins_state.h)
+  const char* process_group;
+  double tiny_std;         ///< floor of the prior std (a zero std holds the block)
+};
+
+constexpr ImuErrorKindInfo kImuErrorKindTable[kImuErrorKinds] = {
+    {&ImuErrors::bg_radps, err::kBg, "gyro_bias_process", 1e-12},
+    {&ImuErrors::ba_mps2, err::kBa, "accel_bias_process", 1e-10},
+    {&ImuErrors::sg, err::kSg, "gyro_scale_process", 1e-9},
+    {&ImuErrors::sa, err::kSa, "accel_scale_process", 1e-9},
+};
+
 /// The parameter blocks and the initial information of one state.
 struct BatchState {
   double t_s = 0.0;
@@ -135,17 +154,25 @@ struct BatchState {
   std::array<double, 3> pos{};  ///< lat_rad, lon_rad, h_m
   std::array<double, 3> vel{};  ///< v_n_mps
   std::array<double, 4> q{};    ///< q_n_b x, y, z, w
-  std::array<double, 3> bg{};   ///< own gyro bias block (unused when shared)
-  std::array<double, 3> ba{};
-  double* bg_block = nullptr;   ///< the gyro bias block of this state (own or shared)
-  double* ba_block = nullptr;
-  InsState initial;             ///< mechanized from the start solution (scale factors used)
+  /// Own IMU-error blocks per ImuErrorKind (unused when shared): rad/s, m/s^2, -, -.
+  std::array<std::array<double, 3>, kImuErrorKinds> own{};
+  std::array<double*, kImuErrorKinds> imu{};  ///< this state's blocks (own or shared; null: not estimated)
+  InsState initial;             ///< mechanized from the start solution
   Eigen::Vector3d omega_ib_b_radps = Eigen::Vector3d::Zero();  ///< bias-corrected, at t_s
   ins::ImuMotion motion;        ///< MotionWindow at t_s
   bool still = false;           ///< the stillness rule holds at t_s
 };
 
-/// How a bias (gyro or accelerometer) is modelled.
+/// The biases and scale factors a state's blocks hold (the start's where not estimated).
+ImuErrors ErrorsOf(const BatchState& s) {
+  ImuErrors e = s.initial.imu;
+  for (int k = 0; k < kImuErrorKinds; ++k) {
+    if (s.imu[k] != nullptr) e.*kImuErrorKindTable[k].member = Eigen::Map<const Eigen::Vector3d>(s.imu[k]);
+  }
+  return e;
+}
+
+/// How an IMU error (a bias or a scale factor) is modelled.
 struct BiasModel {
   bool shared = false;     ///< one block for all states (no process noise)
   bool constant = false;   ///< shared and held (zero initial std)
@@ -247,8 +274,9 @@ class BatchSmoother : public ins::BatchAccess {
   std::vector<int> aux_begin_;           ///< per source: its first auxiliary block
   std::size_t current_ = 0;              ///< the source adding its residuals
 
-  BiasModel gyro_model_, accel_model_;
-  std::array<double, 3> shared_bg_{}, shared_ba_{};
+  int imu_kinds_ = 2;  ///< the ImuErrorKinds estimated: the biases, and the scale factors
+  std::array<BiasModel, kImuErrorKinds> imu_models_;
+  std::array<std::array<double, 3>, kImuErrorKinds> shared_imu_{};
   std::vector<BatchState> states_;
   std::vector<std::shared_ptr<ImuPreintegration>> pre_;  ///< interval i: states i -> i + 1
   std::vector<ceres::ResidualBlockId> imu_factors_;
@@ -290,16 +318,22 @@ void BatchSmoother::Check() const {
 }
 
 void BatchSmoother::Initialise(const Plan& plan) {
-  const Eigen::VectorXd init_std = InitialStdVector(cfg_, err::kSize15);
+  imu_kinds_ = cfg_.filter.scale_factors ? kImuErrorKinds : kGyroScale;
+  const Eigen::VectorXd init_std = InitialStdVector(cfg_, err::kSize21);
   const ImuNoise& n = cfg_.imu_noise;
-  gyro_model_ = MakeBiasModel(n.gyro_bias_std_radps, n.correlation_time_s, init_std.segment<3>(err::kBg), 1e-12);
-  accel_model_ = MakeBiasModel(n.accel_bias_std_mps2, n.correlation_time_s, init_std.segment<3>(err::kBa), 1e-10);
+  const double steady_std[kImuErrorKinds] = {n.gyro_bias_std_radps, n.accel_bias_std_mps2, n.gyro_scale_std,
+                                             n.accel_scale_std};
+  for (int k = 0; k < imu_kinds_; ++k) {
+    const ImuErrorKindInfo& kind = kImuErrorKindTable[k];
+    imu_models_[k] = MakeBiasModel(steady_std[k], n.correlation_time_s, init_std.segment<3>(kind.err_index),
+                                   kind.tiny_std);
+  }
   states_.resize(plan.states.size());
   for (std::size_t i = 0; i < states_.size(); ++i) {
-    states_[i].t_s = plan.states[i].t_s;
-    states_[i].anchor = plan.states[i].anchor;
-    states_[i].bg_block = gyro_model_.shared ? shared_bg_.data() : states_[i].bg.data();
-    states_[i].ba_block = accel_model_.shared ? shared_ba_.data() : states_[i].ba.data();
+    BatchState& s = states_[i];
+    s.t_s = plan.states[i].t_s;
+    s.anchor = plan.states[i].anchor;
+    for (int k = 0; k < imu_kinds_; ++k) s.imu[k] = imu_models_[k].shared ? shared_imu_[k].data() : s.own[k].data();
   }
   thinned_ = plan.thinned;
   for (const auto& source : sources_) {
@@ -330,9 +364,9 @@ void BatchSmoother::MakeViews() {
 
 /// One pass over the IMU record: the strapdown mechanization from the latest knot of the
 /// start solution (reset at every knot, with that knot's IMU errors) gives each state's
-/// initial value; the same pieces of samples, split at the state (and knot) times and
-/// corrected for the scale factors of the interval's first state, go into that interval's
-/// preintegration, linearised at the first state's bias blocks' initial values.
+/// initial value; the same pieces of samples, split at the state (and knot) times, go into
+/// that interval's preintegration, linearised at the first state's IMU errors (its blocks'
+/// initial values; the start solution's scale factors where they are not estimated).
 void BatchSmoother::MechanizeAndPreintegrate() {
   const std::vector<NavEpoch>& knots = start_.epochs;
   const std::vector<ImuSample>& imu = in_.imu;
@@ -349,7 +383,6 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   if (still_rule != nullptr) detector.emplace(*still_rule);
   ins::MotionWindow motion(noise.gyro_arw_rad_per_sqrt_s, noise.accel_vrw_mps_per_sqrt_s);
   double tilt_var = KnotTiltVariance(knots.front());  // of the knot the mechanization started at
-  ImuErrors scale;  // the scale factors of the current interval (biases zero)
 
   // The bias blocks' initial values: each state's from its knot, shared ones from the first.
   const auto record_state = [&]() {
@@ -365,24 +398,14 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     s.vel = {nav.v_n_mps.x(), nav.v_n_mps.y(), nav.v_n_mps.z()};
     const Eigen::Quaterniond q = nav.q_n_b.normalized();
     s.q = {q.x(), q.y(), q.z(), q.w()};
-    for (int k = 0; k < 3; ++k) {
-      s.bg[k] = errors.bg_radps[k];
-      s.ba[k] = errors.ba_mps2[k];
-    }
-    if (si == 0) {
-      for (int k = 0; k < 3; ++k) {
-        shared_bg_[k] = errors.bg_radps[k];
-        shared_ba_[k] = errors.ba_mps2[k];
-      }
+    for (int k = 0; k < imu_kinds_; ++k) {
+      const Eigen::Vector3d& value = errors.*kImuErrorKindTable[k].member;
+      Eigen::Map<Eigen::Vector3d>(s.own[k].data()) = value;
+      if (si == 0) Eigen::Map<Eigen::Vector3d>(shared_imu_[k].data()) = value;
     }
     if (si + 1 < n) {
-      const Eigen::Vector3d bg_lin = Eigen::Map<const Eigen::Vector3d>(s.bg_block);
-      const Eigen::Vector3d ba_lin = Eigen::Map<const Eigen::Vector3d>(s.ba_block);
-      pre_[si] = std::make_shared<ImuPreintegration>(bg_lin, ba_lin, noise.gyro_arw_rad_per_sqrt_s,
+      pre_[si] = std::make_shared<ImuPreintegration>(ErrorsOf(s), noise.gyro_arw_rad_per_sqrt_s,
                                                      noise.accel_vrw_mps_per_sqrt_s);
-      scale = ImuErrors{};
-      scale.sg = errors.sg;
-      scale.sa = errors.sa;
     }
     ++si;
   };
@@ -403,7 +426,7 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     strapdown.Update(c);
     motion.Add(c, strapdown.state().v_n_mps - v_before_n_mps);
     omega = c.dtheta_b_rad / c.dt_s;
-    pre_[si - 1]->Integrate(CorrectImu(piece, scale));
+    pre_[si - 1]->Integrate(piece);
     ++imu_samples_;
   };
 
@@ -451,12 +474,13 @@ void BatchSmoother::AddImuFactor(std::size_t i) {
   BatchState& a = states_[i];
   BatchState& b = states_[i + 1];
   const int rotation = groups_.Group(kImuRotationGroup), translation = groups_.Group(kImuTranslationGroup);
-  imu_factors_[i] = problem_->AddResidualBlock(
-      groups_.Wrap(CreateImuFactor(pre_[i]), {rotation, rotation, rotation, translation, translation, translation,
-                                              translation, translation, translation}),
-      nullptr,
-                                               {a.pos.data(), a.vel.data(), a.q.data(), a.bg_block, a.ba_block,
-                                                b.pos.data(), b.vel.data(), b.q.data()});
+  const std::vector<int> rows = {rotation,    rotation,    rotation,    translation, translation,
+                                 translation, translation, translation, translation};
+  std::vector<double*> blocks = {a.pos.data(), a.vel.data(), a.q.data()};
+  for (int k = 0; k < imu_kinds_; ++k) blocks.push_back(a.imu[k]);
+  for (double* block : {b.pos.data(), b.vel.data(), b.q.data()}) blocks.push_back(block);
+  ceres::CostFunction* cost = imu_kinds_ == kImuErrorKinds ? CreateImuScaleFactor(pre_[i]) : CreateImuFactor(pre_[i]);
+  imu_factors_[i] = problem_->AddResidualBlock(groups_.Wrap(cost, rows), nullptr, blocks);
 }
 
 void BatchSmoother::AddPriors() {
@@ -486,13 +510,10 @@ void BatchSmoother::AddPriors() {
   problem_->AddResidualBlock(
       prior(AttitudePrior::Create(c.q_n_b, Eigen::Matrix3d(att_std.cwiseInverse().asDiagonal()))), nullptr,
       s.q.data());
-  if (!gyro_model_.constant) {
-    problem_->AddResidualBlock(prior(VectorPrior3::Create(centre.imu.bg_radps, gyro_model_.prior_std)), nullptr,
-                               s.bg_block);
-  }
-  if (!accel_model_.constant) {
-    problem_->AddResidualBlock(prior(VectorPrior3::Create(centre.imu.ba_mps2, accel_model_.prior_std)), nullptr,
-                               s.ba_block);
+  for (int k = 0; k < imu_kinds_; ++k) {
+    if (imu_models_[k].constant) continue;
+    const Eigen::Vector3d& value = centre.imu.*kImuErrorKindTable[k].member;
+    problem_->AddResidualBlock(prior(VectorPrior3::Create(value, imu_models_[k].prior_std)), nullptr, s.imu[k]);
   }
 }
 
@@ -508,27 +529,24 @@ void BatchSmoother::BuildProblem() {
     problem_->AddParameterBlock(s.pos.data(), 3, &position_manifold_);
     problem_->AddParameterBlock(s.vel.data(), 3);
     problem_->AddParameterBlock(s.q.data(), 4, &attitude_manifold_);
-    if (!gyro_model_.shared || &s == &states_.front()) problem_->AddParameterBlock(s.bg_block, 3);
-    if (!accel_model_.shared || &s == &states_.front()) problem_->AddParameterBlock(s.ba_block, 3);
+    for (int k = 0; k < imu_kinds_; ++k) {
+      if (!imu_models_[k].shared || &s == &states_.front()) problem_->AddParameterBlock(s.imu[k], 3);
+    }
   }
-  if (gyro_model_.constant) problem_->SetParameterBlockConstant(shared_bg_.data());
-  if (accel_model_.constant) problem_->SetParameterBlockConstant(shared_ba_.data());
+  for (int k = 0; k < imu_kinds_; ++k) {
+    if (imu_models_[k].constant) problem_->SetParameterBlockConstant(shared_imu_[k].data());
+  }
 
   imu_factors_.assign(pre_.size(), nullptr);
   for (std::size_t i = 0; i + 1 < states_.size(); ++i) {
     AddImuFactor(i);
     const double dt = states_[i + 1].t_s - states_[i].t_s;
-    if (!gyro_model_.shared) {
-      problem_->AddResidualBlock(Group(BiasGaussMarkov::Create(dt, gyro_model_.tau_s, gyro_model_.steady_std),
-                                       "gyro_bias_process"),
-                                 nullptr,
-                                 states_[i].bg_block, states_[i + 1].bg_block);
-    }
-    if (!accel_model_.shared) {
-      problem_->AddResidualBlock(Group(BiasGaussMarkov::Create(dt, accel_model_.tau_s, accel_model_.steady_std),
-                                       "accel_bias_process"),
-                                 nullptr,
-                                 states_[i].ba_block, states_[i + 1].ba_block);
+    for (int k = 0; k < imu_kinds_; ++k) {
+      const BiasModel& m = imu_models_[k];
+      if (m.shared) continue;
+      problem_->AddResidualBlock(
+          Group(BiasGaussMarkov::Create(dt, m.tau_s, m.steady_std), kImuErrorKindTable[k].process_group), nullptr,
+          states_[i].imu[k], states_[i + 1].imu[k]);
     }
   }
   for (std::size_t i = 0; i < sources_.size(); ++i) {
@@ -554,21 +572,23 @@ void BatchSmoother::AddAuxPriors() {
   }
 }
 
-/// Reintegrates the intervals whose gyro bias moved too far from the linearisation point
-/// and replaces their factors; returns how many.
+/// Reintegrates the intervals whose gyro bias (or gyro scale factor) moved too far from the
+/// linearisation point and replaces their factors; returns how many. Too far: the bias by
+/// batch.relinearize_bias_radps when set, else the first-order attitude correction
+/// |J_R_bg dbg + J_R_sg dsg| beyond a tenth of the interval's gyro noise arw sqrt(dt).
 int BatchSmoother::Reintegrate() {
   const double arw = cfg_.imu_noise.gyro_arw_rad_per_sqrt_s;
   const double fixed = cfg_.batch.relinearize_bias_radps;
   int count = 0;
   for (std::size_t i = 0; i < pre_.size(); ++i) {
     ImuPreintegration& pre = *pre_[i];
-    const Eigen::Vector3d bg = Eigen::Map<const Eigen::Vector3d>(states_[i].bg_block);
-    const Eigen::Vector3d ba = Eigen::Map<const Eigen::Vector3d>(states_[i].ba_block);
-    const double moved = (bg - pre.bg_lin_radps()).norm();
+    const ImuErrors now = ErrorsOf(states_[i]);
     const double dt = pre.dt_s();
-    const bool too_far = fixed > 0.0 ? moved > fixed : moved * dt > 0.1 * arw * std::sqrt(dt);
+    const Eigen::Vector3d dbg = now.bg_radps - pre.bg_lin_radps();
+    const Eigen::Vector3d correction_rad = pre.J_R_bg() * dbg + pre.J_R_sg() * (now.sg - pre.lin().sg);
+    const bool too_far = fixed > 0.0 ? dbg.norm() > fixed : correction_rad.norm() > 0.1 * arw * std::sqrt(dt);
     if (!too_far) continue;
-    pre.Reintegrate(bg, ba);
+    pre.Reintegrate(now);
     problem_->RemoveResidualBlock(imu_factors_[i]);
     AddImuFactor(i);
     ++count;
@@ -657,10 +677,10 @@ void BatchSmoother::Covariance(Solution* solution, std::ostringstream* report) {
   std::vector<const double*> blocks;
   std::set<const double*> seen;
   for (const BatchState& s : states_) {
-    for (const double* b : {static_cast<const double*>(s.pos.data()), static_cast<const double*>(s.vel.data()),
-                            static_cast<const double*>(s.q.data()), static_cast<const double*>(s.bg_block),
-                            static_cast<const double*>(s.ba_block)}) {
-      if (seen.insert(b).second) blocks.push_back(b);
+    std::vector<const double*> own = {s.pos.data(), s.vel.data(), s.q.data()};
+    for (int k = 0; k < imu_kinds_; ++k) own.push_back(s.imu[k]);
+    for (const double* b : own) {
+      if (seen.insert(b).second && !problem_->IsParameterBlockConstant(b)) blocks.push_back(b);
     }
   }
   for (const double& a : aux_) {
@@ -679,12 +699,15 @@ void BatchSmoother::Covariance(Solution* solution, std::ostringstream* report) {
   for (std::size_t i = 0; i < states_.size(); ++i) {
     const BatchState& s = states_[i];
     Eigen::VectorXd& std = solution->epochs[i].std;
-    std.resize(err::kSize15);
+    std.resize(imu_kinds_ == kImuErrorKinds ? err::kSize21 : err::kSize15);
     std.segment<3>(err::kPos) = stds[s.pos.data()];
     std.segment<3>(err::kVel) = stds[s.vel.data()];
     std.segment<3>(err::kAtt) = stds[s.q.data()];
-    std.segment<3>(err::kBg) = stds[s.bg_block];
-    std.segment<3>(err::kBa) = stds[s.ba_block];
+    for (int k = 0; k < imu_kinds_; ++k) {
+      const auto it = stds.find(s.imu[k]);  // absent: held constant
+      std.segment<3>(kImuErrorKindTable[k].err_index) =
+          it != stds.end() ? Eigen::Vector3d(it->second) : Eigen::Vector3d::Zero();
+    }
     Eigen::VectorXd& aux_std = solution->epochs[i].aux_std;
     aux_std = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(aux_.size()));
     for (std::size_t k = 0; k < aux_.size(); ++k) {
@@ -741,9 +764,7 @@ Solution BatchSmoother::Run() {
     x.nav.h_m = s.pos[2];
     x.nav.v_n_mps = Eigen::Vector3d(s.vel[0], s.vel[1], s.vel[2]);
     x.nav.q_n_b = Eigen::Quaterniond(s.q[3], s.q[0], s.q[1], s.q[2]).normalized();
-    x.imu = s.initial.imu;  // scale factors as used
-    x.imu.bg_radps = Eigen::Map<const Eigen::Vector3d>(s.bg_block);
-    x.imu.ba_mps2 = Eigen::Map<const Eigen::Vector3d>(s.ba_block);
+    x.imu = ErrorsOf(s);
     solution.epochs[i].aux = Eigen::Map<const Eigen::VectorXd>(aux_.data(), static_cast<Eigen::Index>(aux_.size()));
   }
   if (cfg_.batch.covariance) Covariance(&solution, &report);
