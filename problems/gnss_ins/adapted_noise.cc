@@ -36,6 +36,9 @@ AdaptedNoise AdaptNoise(const GnssInsConfig& config, const std::map<std::string,
         &c.imu_noise.gyro_bias_std_radps, &out);
   Scale(residuals, "accel_bias_process", "accelerometer bias std", 1.0 / kMicroG_mps2, "ug",
         &c.imu_noise.accel_bias_std_mps2, &out);
+  Scale(residuals, "gyro_scale_process", "gyro scale-factor std", 1.0 / kPpm, "ppm", &c.imu_noise.gyro_scale_std, &out);
+  Scale(residuals, "accel_scale_process", "accelerometer scale std", 1.0 / kPpm, "ppm", &c.imu_noise.accel_scale_std,
+        &out);
   Scale(residuals, "gnss_position_h", "GNSS position sigma N, E", 1.0, "x file sigma", &c.gnss.pos_sigma_scale_h, &out);
   Scale(residuals, "gnss_position_v", "GNSS position sigma D", 1.0, "x file sigma", &c.gnss.pos_sigma_scale_v, &out);
   Scale(residuals, "gnss_velocity_h", "GNSS velocity sigma N, E", 1.0, "x file sigma", &c.gnss.vel_sigma_scale_h, &out);

@@ -21,6 +21,7 @@
 #include "problems/gnss_ins/densify.h"
 #include "problems/gnss_ins/diagnostics.h"
 #include "problems/gnss_ins/filter.h"
+#include "problems/gnss_ins/initial_state.h"
 #include "problems/gnss_ins/output.h"
 #include "problems/gnss_ins/sim_config.h"
 
@@ -161,6 +162,7 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   GnssInsRun run;
   run.inputs = SummarizeInputs(inputs);
   run.output_rate_hz = config.output_rate_hz;
+  run.prior_std = InitialStdVector(config, config.filter.scale_factors ? ins::err::kSize21 : ins::err::kSize15);
   NavOutputWriter writer(options.out_dir, config.filter.scale_factors);
   ErrorFiles error_files;
   RunEstimators(RunSinks{options, config, inputs, &writer, &error_files}, &run);

@@ -79,6 +79,9 @@ struct GnssInsRun {
   /// The noise values the batch's variance components changed, one line each ("gyro ARW
   /// 0.912 -> 2.93 deg/sqrt(h) ..."); empty without adaptation.
   std::vector<std::string> adapted_noise;
+  /// The configured prior std of the error state (InitialStdVector; 15 or 21 entries), for
+  /// judging whether the record observed the IMU scale factors.
+  Eigen::VectorXd prior_std;
 };
 
 /// Runs options.methods over the record with `config` and writes the outputs and

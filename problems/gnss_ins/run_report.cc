@@ -1,10 +1,13 @@
 // The report of a GNSS/INS run (run.h): summary.json (WriteRunSummary) and the text a
-// person reads (RunTable): inputs, per method the errors, err/sigma, auxiliary states,
-// residual statistics, the adapted noise and the warnings.
+// person reads (RunTable): inputs, per method the errors, err/sigma, the estimated
+// parameters (auxiliary states, IMU scale factors), residual statistics, the adapted noise
+// and the warnings.
+#include <algorithm>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "core/units.h"
 #include "problems/gnss_ins/run.h"
@@ -194,41 +197,96 @@ void AppendConsistencyTable(std::string* s, const GnssInsRun& run) {
 /// prior std is not observable from the record: the data hardly moved its uncertainty.
 constexpr double kUnobservableSigmaRatio = 0.9;
 
-/// Auxiliary state i at the end of a solution: value, posterior std (NaN when not computed)
-/// and whether the record observed it (posterior std below kUnobservableSigmaRatio times the
-/// prior; a state held at its prior or without a computed std counts as observed: nothing
-/// to say).
-struct AuxEnd {
+/// A parameter estimated over the record (an auxiliary state or an IMU scale factor) at the
+/// end of a solution: value, posterior std (NaN when not computed), prior std and whether
+/// the record observed it (posterior std below kUnobservableSigmaRatio times the prior; a
+/// parameter held at its prior or without a computed std counts as observed: nothing to
+/// say). SI values; the text shows them times to_unit in `unit`.
+struct ParameterEnd {
+  std::string name;
   double value = std::nan("");
   double std = std::nan("");
   double prior_std = 0.0;
   bool observable = true;
+  std::string observed_by;  ///< what in a record makes it observable
+  double to_unit = 1.0;
+  const char* unit = "";
 };
 
-AuxEnd AuxAtEnd(const Solution& solution, std::size_t i) {
-  AuxEnd a;
-  const Eigen::Index k = static_cast<Eigen::Index>(i);
-  const NavEpoch& last = solution.epochs.back();
-  if (k < last.aux.size()) a.value = last.aux[k];
-  if (k < last.aux_std.size()) a.std = last.aux_std[k];
-  a.prior_std = solution.aux_states[i].initial_std;
-  a.observable = !(a.prior_std > 0.0 && a.std >= kUnobservableSigmaRatio * a.prior_std);
-  return a;
+void JudgeObservability(ParameterEnd* p) {
+  p->observable = !(p->prior_std > 0.0 && p->std >= kUnobservableSigmaRatio * p->prior_std);
 }
 
-/// The auxiliary states (the aiding sources' parameters) at the end of a solution, with
-/// their std, prior std and observability, dimensionless SI values.
-void WriteAuxStates(JsonWriter& w, const Solution& solution) {
-  if (solution.aux_states.empty() || solution.epochs.empty()) return;
-  w.Key("aux").BeginObject();
+/// The auxiliary states (the aiding sources' parameters) at the end of a solution.
+std::vector<ParameterEnd> AuxStatesAtEnd(const Solution& solution) {
+  std::vector<ParameterEnd> out;
+  if (solution.epochs.empty()) return out;
+  const NavEpoch& last = solution.epochs.back();
   for (std::size_t i = 0; i < solution.aux_states.size(); ++i) {
-    const AuxEnd a = AuxAtEnd(solution, i);
-    w.Key(solution.aux_states[i].name)
+    const Eigen::Index k = static_cast<Eigen::Index>(i);
+    ParameterEnd p;
+    p.name = solution.aux_states[i].name;
+    if (k < last.aux.size()) p.value = last.aux[k];
+    if (k < last.aux_std.size()) p.std = last.aux_std[k];
+    p.prior_std = solution.aux_states[i].initial_std;
+    p.observed_by = solution.aux_states[i].observed_by;
+    JudgeObservability(&p);
+    out.push_back(p);
+  }
+  return out;
+}
+
+/// The IMU scale factors at the end of a solution with the 21-state model (none otherwise),
+/// judged against the configured prior std (run.prior_std).
+std::vector<ParameterEnd> ScaleFactorsAtEnd(const Solution& solution, const Eigen::VectorXd& prior_std) {
+  std::vector<ParameterEnd> out;
+  if (solution.epochs.empty()) return out;
+  const NavEpoch& last = solution.epochs.back();
+  if (last.std.size() != ins::err::kSize21 || prior_std.size() != ins::err::kSize21) return out;
+  static const char* const kAxes[3] = {"x", "y", "z"};
+  static const char* const kGyroNeeds[3] = {"rotation about the body x axis (roll changes)",
+                                            "rotation about the body y axis (pitch changes)",
+                                            "rotation about the body z axis (turns)"};
+  static const char* const kAccelNeeds[3] = {
+      "specific force along the body x axis that changes (accelerations and decelerations)",
+      "specific force along the body y axis that changes (side forces, or tilts to the side)",
+      "changes of the load along the body z axis (banked turns, pull-ups, tilts)"};
+  for (int sensor = 0; sensor < 2; ++sensor) {
+    const int index = sensor == 0 ? ins::err::kSg : ins::err::kSa;
+    const Eigen::Vector3d& value = sensor == 0 ? last.state.imu.sg : last.state.imu.sa;
+    for (int axis = 0; axis < 3; ++axis) {
+      ParameterEnd p;
+      p.name = std::string(sensor == 0 ? "gyro_scale_" : "accel_scale_") + kAxes[axis];
+      p.value = value[axis];
+      p.std = last.std[index + axis];
+      p.prior_std = prior_std[index + axis];
+      p.observed_by = sensor == 0 ? kGyroNeeds[axis] : kAccelNeeds[axis];
+      p.to_unit = 1.0 / kPpm;
+      p.unit = " ppm";
+      JudgeObservability(&p);
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
+std::vector<ParameterEnd> ParametersAtEnd(const Solution& solution, const Eigen::VectorXd& prior_std) {
+  std::vector<ParameterEnd> out = AuxStatesAtEnd(solution);
+  for (ParameterEnd& p : ScaleFactorsAtEnd(solution, prior_std)) out.push_back(p);
+  return out;
+}
+
+/// One JSON object of parameters, dimensionless SI values.
+void WriteParameters(JsonWriter& w, const char* key, const std::vector<ParameterEnd>& parameters) {
+  if (parameters.empty()) return;
+  w.Key(key).BeginObject();
+  for (const ParameterEnd& p : parameters) {
+    w.Key(p.name)
         .BeginObject()
-        .Field("value", a.value)
-        .Field("std", a.std)
-        .Field("prior_std", a.prior_std)
-        .Field("observable", a.observable)
+        .Field("value", p.value)
+        .Field("std", p.std)
+        .Field("prior_std", p.prior_std)
+        .Field("observable", p.observable)
         .EndObject();
   }
   w.EndObject();
@@ -254,28 +312,37 @@ void WriteResiduals(JsonWriter& w, const Solution& solution) {
   w.EndObject();
 }
 
-/// One line per auxiliary state: each method's value at the end +- its std, or "not
-/// observable" when the record left its std near the prior, followed by the reason.
-void AppendAuxStates(std::string* s, const GnssInsRun& run) {
-  if (run.methods.empty()) return;
-  const std::vector<ins::AuxState>& states = run.methods.front().solution.aux_states;
-  for (std::size_t i = 0; i < states.size(); ++i) {
-    Append(s, "%s at the end:", states[i].name.c_str());
-    bool unobserved = false;
-    for (const MethodRun& m : run.methods) {
-      if (m.solution.epochs.empty() || m.solution.aux_states.size() <= i) continue;
-      const AuxEnd a = AuxAtEnd(m.solution, i);
-      if (a.observable) {
-        Append(s, " %s %.6g +- %.2g", m.name.c_str(), a.value, a.std);
-      } else {
-        Append(s, " %s not observable", m.name.c_str());
-        unobserved = true;
+/// One line per parameter (auxiliary states, IMU scale factors): each method's value at the
+/// end +- its std, or "not observable" when the record left its std near the prior,
+/// followed by the reason.
+void AppendParameters(std::string* s, const GnssInsRun& run) {
+  std::vector<std::vector<ParameterEnd>> per_method;
+  std::vector<std::string> names;
+  for (const MethodRun& m : run.methods) {
+    per_method.push_back(ParametersAtEnd(m.solution, run.prior_std));
+    for (const ParameterEnd& p : per_method.back()) {
+      if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+    }
+  }
+  for (const std::string& name : names) {
+    Append(s, "%s at the end:", name.c_str());
+    const ParameterEnd* unobserved = nullptr;
+    for (std::size_t m = 0; m < run.methods.size(); ++m) {
+      for (const ParameterEnd& p : per_method[m]) {
+        if (p.name != name) continue;
+        if (p.observable) {
+          Append(s, " %s %.6g +- %.2g%s", run.methods[m].name.c_str(), p.value * p.to_unit, p.std * p.to_unit, p.unit);
+        } else {
+          Append(s, " %s not observable", run.methods[m].name.c_str());
+          unobserved = &p;
+        }
       }
     }
     Append(s, "\n");
-    if (unobserved) {
-      Append(s, "  not observable from this record: posterior sigma >= %.1f x prior sigma %.3g; it needs %s\n",
-             kUnobservableSigmaRatio, states[i].initial_std, states[i].observed_by.c_str());
+    if (unobserved != nullptr) {
+      Append(s, "  not observable from this record: posterior sigma >= %.1f x prior sigma %.4g%s; it needs %s\n",
+             kUnobservableSigmaRatio, unobserved->prior_std * unobserved->to_unit, unobserved->unit,
+             unobserved->observed_by.c_str());
     }
   }
 }
@@ -346,7 +413,8 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
       w.Key(key).BeginObject().Field("used", count.used).Field("rejected", count.rejected).EndObject();
     }
     w.EndObject();
-    WriteAuxStates(w, m.solution);
+    WriteParameters(w, "aux", AuxStatesAtEnd(m.solution));
+    WriteParameters(w, "imu_scale_factors", ScaleFactorsAtEnd(m.solution, run.prior_std));
     WriteResiduals(w, m.solution);
     if (!m.solution.solver_report.empty()) w.Field("solver_report", m.solution.solver_report);
     if (m.errors) {
@@ -389,7 +457,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
     for (const MethodRun& m : run.methods) {
       Append(&s, "%-14s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
     }
-    AppendAuxStates(&s, run);
+    AppendParameters(&s, run);
     AppendResidualStats(&s, run);
     AppendAdaptedNoise(&s, run);
     AppendWarnings(&s, run);
@@ -405,7 +473,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   Append(&s, " %10s\n", "run [s]");
   for (const MethodRun& m : run.methods) AppendErrorRow(&s, m, outages);
   AppendConsistencyTable(&s, run);
-  AppendAuxStates(&s, run);
+  AppendParameters(&s, run);
   AppendResidualStats(&s, run);
   AppendAdaptedNoise(&s, run);
   AppendWarnings(&s, run);

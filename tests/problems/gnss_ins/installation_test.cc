@@ -23,6 +23,7 @@
 #include "core/units.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/filter.h"
+#include "problems/gnss_ins/initial_state.h"
 #include "problems/gnss_ins/run.h"
 #include "problems/gnss_ins/sim_config.h"
 #include "problems/ins/nav_error.h"
@@ -392,6 +393,7 @@ TEST(InstallationObservability, ASteadyFlightLeavesTheParametersAtTheirPrior) {
     EXPECT_GE(ef.std[k], 0.9 * prior[k]);
   }
   GnssInsRun run;
+  run.prior_std = InitialStdVector(c, ins::err::kSize21);
   run.methods.push_back({"filter", f.filter, std::nullopt, ""});
   run.methods.push_back({"batch", b, std::nullopt, ""});
   RunOptions options;
@@ -400,12 +402,24 @@ TEST(InstallationObservability, ASteadyFlightLeavesTheParametersAtTheirPrior) {
   EXPECT_NE(table.find("gnss_lever_arm_z_m at the end: filter not observable batch not observable"),
             std::string::npos);
   EXPECT_NE(table.find("it needs rotation about the body x and y axes (roll and pitch changes)"), std::string::npos);
+  // The scale factors: straight and level, no rotation but the Earth's.
+  EXPECT_NE(table.find("gyro_scale_z at the end: filter not observable batch not observable"), std::string::npos);
+  EXPECT_NE(table.find("not observable from this record: posterior sigma >= 0.9 x prior sigma 5000 ppm; it needs "
+                       "rotation about the body z axis (turns)"),
+            std::string::npos);
   std::ostringstream json;
   JsonWriter w(json);
   WriteRunSummary(w, options, run);
   EXPECT_NE(json.str().find("\"gnss_time_offset_s\":{\"value\""), std::string::npos) << json.str();
-  EXPECT_NE(json.str().find("\"observable\":false"), std::string::npos);
-  EXPECT_EQ(json.str().find("\"observable\":true"), std::string::npos);
+  EXPECT_NE(json.str().find("\"imu_scale_factors\":{\"gyro_scale_x\":{\"value\""), std::string::npos);
+  // Every installation parameter is unobservable (the accelerometer z scale factor is not:
+  // gravity on a z bias known to 1000 ug observes it to 980 ppm).
+  const std::string summary = json.str();
+  for (std::size_t at = summary.find("\"aux\":{"); at != std::string::npos; at = summary.find("\"aux\":{", at + 1)) {
+    const std::string aux = summary.substr(at, summary.find("\"imu_scale_factors\"", at) - at);
+    EXPECT_NE(aux.find("\"observable\":false"), std::string::npos) << aux;
+    EXPECT_EQ(aux.find("\"observable\":true"), std::string::npos) << aux;
+  }
 }
 
 // The demo's configuration (navtwin smooth --demo) gives a simulated latency as the known
