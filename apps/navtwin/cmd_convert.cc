@@ -129,13 +129,11 @@ NavAsGnssOptions ReferenceSigmas(FileFormat f) {
 /// What a user of fixes made from the ANSFL reference must know, on stderr.
 void ReportAnsflReference(FileFormat f, const NavAsGnssOptions& o) {
   std::cerr << "navtwin convert: " << FLAGS_in << ": the DJI reference as GNSS fixes, sigma " << o.pos_sigma_m
-            << " m and " << o.vel_sigma_mps << " m/s per axis; heights above mean sea level (the DJI log's)
-";
+            << " m and " << o.vel_sigma_mps << " m/s per axis; heights above mean sea level (the DJI log's)\n";
   if (f == FileFormat::kAnsflGtExtended) {
     std::cerr << "navtwin convert: note: GTExtended.csv times are the DJI log's clock (ms / 1000); the "
                  "time offset transfer-align-ansfl writes refers to GT.csv's times: convert GT.csv (it takes "
-                 "GTExtended.csv's speeds and origin when beside it) to use that calibration
-";
+                 "GTExtended.csv's speeds and origin when beside it) to use that calibration\n";
   } else {
     std::cerr << "navtwin convert: GT.csv times (s from the path start); velocity from GTExtended.csv's speeds "
                  "when beside it, else differenced positions; origin of N/E/D: GTExtended.csv's first row, else "
