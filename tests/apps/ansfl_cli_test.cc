@@ -50,8 +50,9 @@ TEST(AnsflCli, ConvertMisuseIsACommandLineErrorAndWritesNothing) {
   const std::string dir = MakeTempDir("ansfl");
   WriteGt(dir + "/GT.csv", 5);
   const std::string convert = "convert --in " + dir + "/GT.csv --what gnss --out " + dir + "/out.txt ";
+  // (--pos_sigma_m nan is the flags' "not given": FlagGiven cannot tell them apart.)
   for (const std::string& bad : {std::string("--pos_sigma_m 0"), std::string("--vel_sigma_mps -0.1"),
-                                 std::string("--pos_sigma_m nan")}) {
+                                 std::string("--vel_sigma_mps inf")}) {
     const RunResult r = Navtwin(convert + bad);
     EXPECT_EQ(r.exit_code, 2) << bad;
     EXPECT_NE(r.err.find("must be > 0"), std::string::npos) << r.err;
