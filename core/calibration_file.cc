@@ -17,6 +17,7 @@
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/config/yaml_config.h"
+#include "core/units.h"
 
 namespace navtwin {
 namespace {
@@ -202,6 +203,49 @@ MagCorrection ParseMag(const ConfigNode& mag) {
   return m;
 }
 
+/// A sigma vector of the installation: each entry > 0 and finite, or null (not estimated).
+Eigen::Vector3d PositiveOrNullVector(const ConfigNode& n, const std::string& key) {
+  const Eigen::Vector3d v = ReadVector3(n, key, true);
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isnan(v[i]) && !(v[i] > 0.0)) n.Fail(key, "a sigma must be > 0 (or null: not estimated), got " + Num(v[i]));
+  }
+  return v;
+}
+
+ImuInstallation ParseImuInstallation(const ConfigNode& n) {
+  n.RequireKeys({"imu_mounting_rpy_rad", "imu_time_offset_s", "sigma"});
+  for (const char* key : {"imu_mounting_rpy_rad", "imu_time_offset_s"}) {
+    if (!n.Has(key)) {
+      n.Fail(key, "required in an installation section (write 0 for a value that is zero; a missing one is "
+                  "never taken as 0)");
+    }
+  }
+  ImuInstallation x;
+  x.mounting_rpy_rad = ReadVector3(n, "imu_mounting_rpy_rad", false);
+  const double limits[3] = {kPi, kPi / 2.0, kPi};  // ZYX Euler ranges of roll, pitch, yaw
+  const char* names[3] = {"roll", "pitch", "yaw"};
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(x.mounting_rpy_rad[i]) > limits[i] + 1e-12) {
+      n.Fail("imu_mounting_rpy_rad", std::string(names[i]) + " " + Num(x.mounting_rpy_rad[i]) + " rad is beyond +-" +
+                                         Num(limits[i]) + " (ZYX Euler angles in radians; degrees given?)");
+    }
+  }
+  x.time_offset_s = Number(n, "imu_time_offset_s", n.yaml()["imu_time_offset_s"], false);
+  if (n.Has("sigma")) {
+    const ConfigNode sigma = n.Child("sigma");
+    sigma.RequireKeys({"imu_mounting_rpy_rad", "imu_time_offset_s"});
+    if (sigma.Has("imu_mounting_rpy_rad")) x.mounting_sigma_rad = PositiveOrNullVector(sigma, "imu_mounting_rpy_rad");
+    if (sigma.Has("imu_time_offset_s")) {
+      const double s = Number(sigma, "imu_time_offset_s", sigma.yaml()["imu_time_offset_s"], true);
+      if (!std::isnan(s) && !(s > 0.0)) {
+        sigma.Fail("imu_time_offset_s", "a sigma must be > 0 (or null: not estimated), got " + Num(s));
+      }
+      x.time_offset_sigma_s = s;
+    }
+  }
+  return x;
+}
+
 // ---------------------------------------------------------------- writing
 
 /// A number of the file in the shortest form that reads back exactly; in sigma blocks
@@ -249,6 +293,15 @@ void WriteRows(std::ostream& out, const std::string& key, const std::vector<Eige
   out << "    " << key << ": [";
   for (std::size_t k = 0; k < rows.size(); ++k) out << (k ? ", " : "") << Vec(rows[k]);
   out << "]\n";
+}
+
+void WriteImuInstallation(std::ostream& s, const ImuInstallation& x) {
+  s << "installation:\n  imu_mounting_rpy_rad: " << Vec(x.mounting_rpy_rad) << "\n  imu_time_offset_s: "
+    << Value(x.time_offset_s) << "\n";
+  if (!x.mounting_sigma_rad && !x.time_offset_sigma_s) return;
+  s << "  sigma:\n";
+  if (x.mounting_sigma_rad) s << "    imu_mounting_rpy_rad: " << Vec(*x.mounting_sigma_rad, true) << "\n";
+  if (x.time_offset_sigma_s) s << "    imu_time_offset_s: " << Value(*x.time_offset_sigma_s, true) << "\n";
 }
 
 /// The compensation of one sample with a calibration whose temperature terms are already
@@ -320,7 +373,7 @@ ImuCalibration ImuCalibration::At(double temperature_degC) const {
 
 CalibrationFile ReadCalibrationFile(const std::string& path) {
   const ConfigNode root = LoadYamlFile(path);
-  root.RequireKeys({"navtwin_calibration", "created_by", "imu", "mag"});
+  root.RequireKeys({"navtwin_calibration", "created_by", "imu", "mag", "installation"});
   if (!root.Has("navtwin_calibration")) {
     root.Fail("navtwin_calibration", "required: the file's format version (" + std::to_string(kFileVersion) +
                                          "); is this a navtwin calibration file?");
@@ -334,6 +387,7 @@ CalibrationFile ReadCalibrationFile(const std::string& path) {
   f.created_by = root.String("created_by", "");
   if (root.Has("imu")) f.imu = ParseImu(root.Child("imu"));
   if (root.Has("mag")) f.mag = ParseMag(root.Child("mag"));
+  if (root.Has("installation")) f.installation = ParseImuInstallation(root.Child("installation"));
   return f;
 }
 
@@ -376,6 +430,7 @@ void WriteCalibrationFile(const std::string& path, const CalibrationFile& file) 
     s << "mag:\n  hard_iron_uT: " << Vec(file.mag->hard_iron_uT) << "\n  correction: " << Mat(file.mag->correction)
       << "\n  field_uT: " << Value(file.mag->field_uT) << "\n";
   }
+  if (file.installation) WriteImuInstallation(s, *file.installation);
   out.Commit();
 }
 
@@ -413,6 +468,11 @@ std::unique_ptr<ImuReader> OpenImu(const std::string& path, const std::string& c
   if (calibration_path.empty()) return OpenImu(path);
   const CalibrationFile file = ReadCalibrationFile(calibration_path);
   if (!file.imu) throw InputError(calibration_path, 0, "imu", "no imu section: the file does not calibrate an IMU");
+  if (file.installation) {
+    throw InputError(calibration_path, 0, "installation",
+                     "an installation section (IMU mounting and time offset) is applied by navigate and smooth "
+                     "only; this command has neither: use a file without it");
+  }
   return CalibratedImuReader(OpenImu(path), *file.imu, temperature_degC);
 }
 

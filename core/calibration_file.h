@@ -20,8 +20,14 @@
 //     correction: [[3]x3]   A: m_corrected = A (m - h), A = (I + S)^-1 for the soft iron S
 //                           (core/mag_iron_model.h); older files name A `soft_iron`
 //     field_uT: B
+//   installation:                         (optional; applied by navigate and smooth only)
+//     imu_mounting_rpy_rad: [r, p, y]     R_b_imu as ZYX Euler angles: v_b = DcmFromEuler(r, p, y) v_imu
+//     imu_time_offset_s: o                added to the IMU time tags (the reference's time scale)
+//     sigma: {imu_mounting_rpy_rad: [3], imu_time_offset_s: x}   (optional, reports only)
 //
-// Any key missing inside a present section means "no error" (zero) for that term.
+// Any key missing inside a present imu or mag section means "no error" (zero) for that
+// term; the installation section needs both of its values (a hand-edited file that lost
+// one would otherwise be applied with a zero there).
 #pragma once
 
 #include <memory>
@@ -69,10 +75,26 @@ struct MagCorrection {
   double field_uT = 0.0;                                    ///< 0: unknown
 };
 
+/// Where the IMU sits on the vehicle and how its clock relates to the reference's: what an
+/// alignment against a reference trajectory estimates (navtwin transfer-align-ansfl). The
+/// same quantities as a GNSS/INS configuration's installation.imu_mounting_deg and
+/// installation.imu_time_offset_s (problems/gnss_ins/config.h), in SI.
+struct ImuInstallation {
+  /// ZYX Euler angles (roll, pitch, yaw) of R_b_imu, v_b = DcmFromEuler(r, p, y) v_imu;
+  /// roll and yaw in [-pi, pi], pitch in [-pi/2, pi/2].
+  Eigen::Vector3d mounting_rpy_rad = Eigen::Vector3d::Zero();
+  /// Added to the IMU time tags to put them on the reference's (GNSS) time scale.
+  double time_offset_s = 0.0;
+  /// One sigma each (NaN: not estimated); written under `sigma` when set.
+  std::optional<Eigen::Vector3d> mounting_sigma_rad;
+  std::optional<double> time_offset_sigma_s;
+};
+
 struct CalibrationFile {
   std::string created_by;
   std::optional<ImuCalibration> imu;
   std::optional<MagCorrection> mag;
+  std::optional<ImuInstallation> installation;
 };
 
 /// Throws InputError naming the file, line and key (unknown keys, wrong sizes, non-finite
@@ -93,7 +115,10 @@ std::unique_ptr<ImuReader> CalibratedImuReader(std::unique_ptr<ImuReader> inner,
 std::unique_ptr<MagReader> CalibratedMagReader(std::unique_ptr<MagReader> inner, const MagCorrection& c);
 
 /// OpenImu / OpenMag (core/io/open.h) followed by the calibration in calibration_path, when
-/// not empty. Throws InputError when the file has no `imu` (resp. `mag`) section.
+/// not empty. Throws InputError when the file has no `imu` (resp. `mag`) section, and
+/// OpenImu when it has an `installation` section: the commands that use these (ins, level,
+/// allan, inflight-align, transfer-align) have no mounting or clock to apply it to, and
+/// dropping it silently would hide that (navigate and smooth read the file themselves).
 std::unique_ptr<ImuReader> OpenImu(const std::string& path, const std::string& calibration_path,
                                    double temperature_degC);
 std::unique_ptr<MagReader> OpenMag(const std::string& path, const std::string& calibration_path);

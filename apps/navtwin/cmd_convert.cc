@@ -6,17 +6,27 @@
 // seconds since boot (core/io/ulog_time.h); which one is printed on stderr, and CSV
 // outputs carry it as a '#' note before the header. `--what px4_estimate` (or `nav`)
 // writes PX4's own EKF2 solution as a KF-GINS navigation file (OpenULogPx4Estimate).
+//
+// Navigation inputs (the ANSFL DJI reference GT.csv / GTExtended.csv, KF-GINS .nav) with
+// `--what gnss`: one GNSS fix per record with the sigma of --pos_sigma_m / --vel_sigma_mps
+// (core/io/nav_as_gnss.h), so a reference solution can aid `smooth` / `navigate`. For the
+// ANSFL files the flags default to kAnsflReferencePosSigma_m / kAnsflReferenceVelSigma_mps
+// (core/io/ansfl.h gives the reasoning); other navigation files need them stated.
 #include <gflags/gflags.h>
 
+#include <cmath>
 #include <iostream>
+#include <utility>
 
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
+#include "core/io/ansfl.h"
 #include "core/io/csv_imu.h"
 #include "core/io/csv_mag_baro.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
+#include "core/io/nav_as_gnss.h"
 #include "core/io/open.h"
 #include "core/io/ulog.h"
 #include "core/io/ulog_time.h"
@@ -26,6 +36,12 @@ DEFINE_string(what, "",
               "Stream to convert: imu, gnss, nav, mag, baro or px4_estimate (ULog: PX4's own "
               "estimate, the same as nav) (default: the file's main stream)");
 DEFINE_string(to, "", "Output format: kfgins or csv (default: csv for a .csv output, else kfgins; mag and baro: csv)");
+DEFINE_double(pos_sigma_m, NAN,
+              "convert --what gnss from a navigation file: position sigma per axis of the fixes, m (ANSFL "
+              "GT.csv/GTExtended.csv default 0.1; required for other navigation files)");
+DEFINE_double(vel_sigma_mps, NAN,
+              "convert --what gnss from a navigation file: velocity sigma per axis of the fixes, m/s (ANSFL "
+              "default 0.15; required for other navigation files)");
 
 namespace navtwin::app {
 namespace {
@@ -95,6 +111,36 @@ void ReportEstimate(const Px4EstimateStats& st) {
                              : " (AMSL: differs from WGS84 heights by the geoid undulation)\n");
 }
 
+bool IsNavFormat(FileFormat f) {
+  return f == FileFormat::kKfginsNav || f == FileFormat::kAnsflGt || f == FileFormat::kAnsflGtExtended;
+}
+
+bool IsAnsflReference(FileFormat f) { return f == FileFormat::kAnsflGt || f == FileFormat::kAnsflGtExtended; }
+
+/// The sigmas of fixes made from a navigation file: the flags, or the ANSFL defaults.
+NavAsGnssOptions ReferenceSigmas(FileFormat f) {
+  NavAsGnssOptions o;
+  o.pos_sigma_m = std::isnan(FLAGS_pos_sigma_m) && IsAnsflReference(f) ? kAnsflReferencePosSigma_m : FLAGS_pos_sigma_m;
+  o.vel_sigma_mps =
+      std::isnan(FLAGS_vel_sigma_mps) && IsAnsflReference(f) ? kAnsflReferenceVelSigma_mps : FLAGS_vel_sigma_mps;
+  return o;
+}
+
+/// What a user of fixes made from the ANSFL reference must know, on stderr.
+void ReportAnsflReference(FileFormat f, const NavAsGnssOptions& o) {
+  std::cerr << "navtwin convert: " << FLAGS_in << ": the DJI reference as GNSS fixes, sigma " << o.pos_sigma_m
+            << " m and " << o.vel_sigma_mps << " m/s per axis; heights above mean sea level (the DJI log's)\n";
+  if (f == FileFormat::kAnsflGtExtended) {
+    std::cerr << "navtwin convert: note: GTExtended.csv times are the DJI log's clock (ms / 1000); the "
+                 "time offset transfer-align-ansfl writes refers to GT.csv's times: convert GT.csv (it takes "
+                 "GTExtended.csv's speeds and origin when beside it) to use that calibration\n";
+  } else {
+    std::cerr << "navtwin convert: GT.csv times (s from the path start); velocity from GTExtended.csv's speeds "
+                 "when beside it, else differenced positions; origin of N/E/D: GTExtended.csv's first row, else "
+                 "the StraightLine take-off point (docs/formats.md)\n";
+  }
+}
+
 /// Converts one stream; returns the sample count. `to` is checked already.
 std::size_t ConvertStream(const std::string& what, const std::string& to, const InputTime& time) {
   const std::string note = time.Note(FLAGS_in);
@@ -105,6 +151,14 @@ std::size_t ConvertStream(const std::string& what, const std::string& to, const 
       return CopyAll(*reader, writer);
     }
     KfginsImuWriter writer(FLAGS_out);
+    return CopyAll(*reader, writer);
+  }
+  if (what == "gnss" && IsNavFormat(DetectFormat(FLAGS_in))) {
+    const FileFormat f = DetectFormat(FLAGS_in);
+    const NavAsGnssOptions sigmas = ReferenceSigmas(f);
+    if (IsAnsflReference(f)) ReportAnsflReference(f, sigmas);
+    auto reader = NavAsGnssReader(OpenNav(FLAGS_in), sigmas);
+    KfginsGnssWriter writer(FLAGS_out);
     return CopyAll(*reader, writer);
   }
   if (what == "gnss") {
@@ -173,6 +227,27 @@ void PrintResult(const std::string& what, const std::string& to, FileFormat in_f
   }
 }
 
+/// --pos_sigma_m / --vel_sigma_mps: only for fixes made from a navigation file, > 0, and
+/// given for navigation files other than the ANSFL reference; "" when fine.
+std::string CheckSigmaFlags(const std::string& what, FileFormat in_format) {
+  const bool given = FlagGiven("pos_sigma_m") || FlagGiven("vel_sigma_mps");
+  const bool nav_to_gnss = what == "gnss" && IsNavFormat(in_format);
+  if (!nav_to_gnss) {
+    return given ? "--pos_sigma_m and --vel_sigma_mps go with --what gnss from a navigation file" : "";
+  }
+  for (const auto& [name, value] : {std::pair<const char*, double>{"pos_sigma_m", FLAGS_pos_sigma_m},
+                                    {"vel_sigma_mps", FLAGS_vel_sigma_mps}}) {
+    if (FlagGiven(name) && !(std::isfinite(value) && value > 0.0)) {
+      return std::string("--") + name + " must be > 0 (a standard deviation)";
+    }
+    if (!FlagGiven(name) && !IsAnsflReference(in_format)) {
+      return std::string("--") + name + " is required for GNSS fixes from a " + FormatName(in_format) +
+             " file (a navigation file carries no sigma)";
+    }
+  }
+  return "";
+}
+
 int RunConvert(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args[0] + "'");
   if (FLAGS_in.empty() || FLAGS_out.empty()) return Usage("--in and --out are required");
@@ -186,6 +261,8 @@ int RunConvert(const std::vector<std::string>& args) {
   std::string why;
   const std::string to = OutputFormat(what, &why);
   if (!why.empty()) return Usage(why);
+  const std::string sigma_error = CheckSigmaFlags(what, in_format);
+  if (!sigma_error.empty()) return Usage(sigma_error);
   InputTime time;
   if (in_format == FileFormat::kULog) {
     time.ulog = true;
@@ -203,8 +280,8 @@ Command ConvertCommand() {
   return {"convert",
           "Convert between formats (ULog, RTKLIB, CSV, drone files -> KF-GINS or CSV; PX4's estimate)",
           "navtwin convert --in F --out F [--what imu|gnss|nav|mag|baro|px4_estimate] [--to kfgins|csv] "
-          "[--format=json]",
-          {"in", "out", "what", "to"},
+          "[--pos_sigma_m S --vel_sigma_mps S (gnss from a navigation file)] [--format=json]",
+          {"in", "out", "what", "to", "pos_sigma_m", "vel_sigma_mps"},
           &RunConvert};
 }
 

@@ -142,8 +142,8 @@ std::string CheckFlags(const Options& opt, const Files& files) {
   if (FLAGS_demo) {
     if (!files.imu.empty() || !files.gnss.empty() || !files.mag.empty() || !files.baro.empty() ||
         !files.config.empty() || !files.kfgins_config.empty() || !files.obgins_config.empty() ||
-        !files.truth.empty()) {
-      return "--demo makes its own --imu, --gnss, --mag, --config and --truth";
+        !files.truth.empty() || !FLAGS_init_from.empty()) {
+      return "--demo makes its own --imu, --gnss, --mag, --config, --truth and initial state";
     }
     if (files.out.empty()) return "--out is required";
   } else if (files.config.empty() + files.kfgins_config.empty() + files.obgins_config.empty() != 2) {
@@ -173,7 +173,7 @@ std::string CheckFlags(const Options& opt, const Files& files) {
 /// do not; empty error, or what is wrong with the command line.
 std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* config) {
   if (!files->config.empty()) {
-    *config = gnss_ins::LoadGnssInsConfig(files->config);
+    *config = gnss_ins::LoadGnssInsConfig(files->config, !FLAGS_init_from.empty());
   } else {
     *config = files->kfgins_config.empty() ? gnss_ins::LoadObginsConfig(files->obgins_config)
                                            : gnss_ins::LoadKfginsConfig(files->kfgins_config);
@@ -196,6 +196,13 @@ std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* confi
     files->baro.clear();
   }
   if (FlagGiven("output_rate_hz")) config->output_rate_hz = FLAGS_output_rate_hz;
+  if (!FLAGS_init_from.empty()) {
+    // The record is picked once the inputs are read (InitConfig::nav_file_at_start): without
+    // --start_s, at the start of the IMU record on the reference's time scale.
+    config->init.source = gnss_ins::InitConfig::Source::kGiven;
+    config->init.state.reset();
+    config->init.nav_file_at_start = FLAGS_init_from;
+  }
   if (!std::isnan(FLAGS_start_s)) {
     // A given initial state was picked for the configuration's start: it must agree.
     if (config->init.state && !std::isnan(config->init.state->nav.t_s) &&
@@ -284,13 +291,13 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
 const char* const kNavigateUsage =
     "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
-    "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
+    "[--outage_period_s P]] [--start_s S] [--end_s S] [--init_from NAV] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--gate_probability P] [--strict] [--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
-    "[--outage_period_s P]] [--start_s S] [--end_s S] [--calibration FILE [--imu_temperature_degC T]] "
+    "[--outage_period_s P]] [--start_s S] [--end_s S] [--init_from NAV] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--gate_probability P] [--variance_components=false] [--strict] [--format=json]\n"
     "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
@@ -306,7 +313,7 @@ Command NavigateCommand() {
           kNavigateUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "smoother", "truth",
            "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
-           "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps", "odometer", "vehicle_mounting_rpy_deg",
+           "calibration", "imu_temperature_degC", "init_from", "nhc", "nhc_sigma_mps", "odometer", "vehicle_mounting_rpy_deg",
            "vehicle_lever_arm_b_m", "gate_probability", "strict"},
           &RunNavigate};
 }
@@ -317,7 +324,7 @@ Command SmoothCommand() {
           kSmoothUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "truth", "output_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
-           "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "nhc", "nhc_sigma_mps",
+           "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "init_from", "nhc", "nhc_sigma_mps",
            "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m", "gate_probability",
            "variance_components", "strict"},
           &RunSmooth};

@@ -16,6 +16,7 @@
 
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
+#include "core/calibration_file.h"
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
@@ -24,6 +25,11 @@
 #include "problems/transfer_alignment/run.h"
 
 DEFINE_string(csv, "", "transfer-align-ansfl: write one row per path and DOT to this CSV file");
+DEFINE_string(path, "", "transfer-align-ansfl: only this path folder under --data, e.g. Horizontal/path_4");
+DEFINE_int32(dot, 0, "transfer-align-ansfl: only this DOT, 1-4 (0: every IMU_k.csv)");
+DEFINE_string(calibration_out, "",
+              "transfer-align-ansfl: write the DOT's mounting, time offset and gyro bias as a calibration file "
+              "(docs/calibration-file.md) for smooth/navigate --calibration; needs --path and --dot");
 
 namespace navtwin::app {
 namespace {
@@ -33,8 +39,10 @@ using transfer::Method;
 
 const char* kUsage =
     "navtwin transfer-align-ansfl --data DIR [--method order2|batch] [--config YAML] [--csv F] [--format=json]\n"
+    "                             [--path TYPE/path_N [--dot K [--calibration_out FILE]]]\n"
     "  DIR: the ansfl-quadrotor folder (StraightLine/path_*, Horizontal/path_*). Default method order2;\n"
-    "  default configuration: the DOT slave against the DJI master (docs/transfer-alignment-real.md).";
+    "  default configuration: the DOT slave against the DJI master (docs/transfer-alignment-real.md).\n"
+    "  --calibration_out: the one path's and DOT's mounting, time offset and gyro bias for smooth --calibration.";
 
 int Usage(const std::string& why) {
   std::cerr << "navtwin transfer-align-ansfl: " << why << "\nusage: " << kUsage << "\n";
@@ -179,6 +187,16 @@ void WriteCsv(const std::vector<AnsflAlignment>& runs, const std::string& path) 
   f.Commit();
 }
 
+/// The command as run (the flags that were set), for the calibration file's created_by.
+std::string AnsflCommandLine() {
+  std::string line = "navtwin transfer-align-ansfl";
+  for (const char* name : {"data", "method", "config", "path", "dot", "calibration_out"}) {
+    gflags::CommandLineFlagInfo info;
+    if (gflags::GetCommandLineFlagInfo(name, &info) && !info.is_default) line += " --" + std::string(name) + "=" + info.current_value;
+  }
+  return line;
+}
+
 int RunTransferAlignAnsfl(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args[0] + "'");
   if (FLAGS_data.empty()) return Usage("--data DIR is required (the ansfl-quadrotor folder)");
@@ -194,9 +212,24 @@ int RunTransferAlignAnsfl(const std::vector<std::string>& args) {
   }
   const transfer::TransferConfig config =
       FLAGS_config.empty() ? transfer::AnsflDotConfig() : transfer::LoadTransferConfig(FLAGS_config);
-  const std::vector<AnsflAlignment> runs = transfer::AlignAllAnsfl(FLAGS_data, config, method);
+  if (FLAGS_dot < 0 || FLAGS_dot > 4) return Usage("--dot must be 1-4 (or 0: all)");
+  if (FLAGS_dot != 0 && FLAGS_path.empty()) return Usage("--dot goes with --path (one path folder)");
+  if (!FLAGS_calibration_out.empty() && (FLAGS_path.empty() || FLAGS_dot == 0)) {
+    return Usage("--calibration_out needs --path and --dot (one path and one DOT: the clock offset differs per path)");
+  }
+  const std::vector<AnsflAlignment> runs =
+      transfer::AlignAllAnsfl(FLAGS_data, config, method, {FLAGS_path, FLAGS_dot});
   const std::vector<DotRepeatability> rep = transfer::AnsflRepeatability(runs);
   if (!FLAGS_csv.empty()) WriteCsv(runs, FLAGS_csv);
+  if (!FLAGS_calibration_out.empty()) {
+    if (runs.size() != 1 || !AnsflRefined(runs.front())) {
+      std::cerr << "navtwin transfer-align-ansfl: no calibration written: "
+                << (runs.empty() ? std::string("nothing aligned") : runs.front().note) << "\n";
+      return kExitFailure;
+    }
+    WriteCalibrationFile(FLAGS_calibration_out, transfer::AnsflCalibrationFile(runs.front(), AnsflCommandLine()));
+    std::cerr << "navtwin transfer-align-ansfl: wrote " << FLAGS_calibration_out << "\n";
+  }
   if (FLAGS_format == "json") {
     std::cout << Json(runs, rep, method) << "\n";
   } else {
@@ -211,7 +244,7 @@ Command TransferAlignAnsflCommand() {
   return {"transfer-align-ansfl",
           "Transfer alignment of the ANSFL quadrotor's Xsens DOTs to the DJI solution: mounting, delay, repeatability",
           kUsage,
-          {"data", "method", "config", "csv"},
+          {"data", "method", "config", "csv", "path", "dot", "calibration_out"},
           &RunTransferAlignAnsfl};
 }
 

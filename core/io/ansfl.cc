@@ -393,6 +393,8 @@ class GtReader final : public NavReader {
       origin_ = *options.origin;
     } else if (ext_) {
       origin_ = ext_first_.position;
+    } else {
+      origin_ = AnsflSiteOrigin();
     }
   }
 
@@ -499,6 +501,14 @@ void AddImuNotes(const DotImuReader& r, FileSummary* summary) {
 }
 
 }  // namespace
+
+wgs84::Geodetic AnsflSiteOrigin() {
+  wgs84::Geodetic g;
+  g.lat_rad = 32.8256829718786 * kDegToRad;
+  g.lon_rad = 34.9559595644856 * kDegToRad;
+  g.h_m = 10.1942341;
+  return g;
+}
 
 std::unique_ptr<ImuReader> OpenAnsflImu(const std::string& path) {
   return std::make_unique<DotImuReader>(path, false);

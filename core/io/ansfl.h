@@ -55,10 +55,33 @@ std::unique_ptr<ImuReader> OpenAnsflDotRawImu(const std::string& path);
 /// InputError when the file has no Mag columns (DOT4's files do not).
 std::unique_ptr<MagReader> OpenAnsflDotRawMag(const std::string& path);
 
+/// The StraightLine flights' take-off point (GTExtended.csv of StraightLine/path_1, first
+/// row: 32.8256829718786 deg N, 34.9559595644856 deg E, 10.1942341 m above mean sea level).
+/// The Horizontal folders have no GTExtended.csv, hence no geodetic origin of their N/E/D
+/// offsets; they were flown by the same group (University of Haifa), so this site stands
+/// in. It sets only the normal gravity and the Earth rate's direction (1e-5 g and 1e-3
+/// deg/h per km of error) and is the same for a GNSS file converted from GT.csv and for
+/// GT.csv as --truth, so errors between the two do not depend on it.
+wgs84::Geodetic AnsflSiteOrigin();
+
+/// Default sigmas of the DJI reference used as GNSS fixes (`navtwin convert --what gnss`
+/// from GT.csv / GTExtended.csv; docs/gnss-ins.md, "Smoothing an ANSFL DOT"):
+///  - position 0.1 m: the N/E/D positions are not rounded; their 10 Hz second differences
+///    are 1.4-3.8 cm RMS with the motion in them, so the noise is below 2 cm. What
+///    dominates is the unknown lever arm from the DJI reference point to a DOT strapped on
+///    the body (the airframe is 0.35 m across: up to about 0.1 m) and the DJI solution's own
+///    error (RTK or not is not logged);
+///  - velocity 0.15 m/s: GTExtended's speeds are rounded to 0.1 m/s (0.029 m/s uniform);
+///    the Horizontal paths have only differenced positions, which on StraightLine/path_2
+///    differ from the speeds by 0.06-0.15 m/s (std per axis); a 0.1 m lever arm adds
+///    omega x l, up to 0.17 m/s in the Horizontal flights' 100 deg/s yaw spins.
+constexpr double kAnsflReferencePosSigma_m = 0.1;
+constexpr double kAnsflReferenceVelSigma_mps = 0.15;
+
 struct AnsflGtOptions {
   /// Origin of the North/East/Down offsets of GT.csv. Unset: the first row of
   /// GTExtended.csv in the same folder when that file exists (it is the point where
-  /// N = E = D = 0), else latitude = longitude = 0 deg, height 0 m.
+  /// N = E = D = 0), else AnsflSiteOrigin().
   std::optional<wgs84::Geodetic> origin;
 };
 

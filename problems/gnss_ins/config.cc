@@ -144,7 +144,8 @@ Installation ParseInstallation(const ConfigNode& n) {
   return x;
 }
 
-InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double start_time_s) {
+InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double start_time_s,
+                     bool state_on_command_line) {
   n.RequireKeys({"source", "nav_file", "time_s", "position_deg_m", "velocity_mps", "attitude_deg",
                  "position_std_m", "velocity_std_mps", "attitude_std_deg", "gyro_bias_deg_h",
                  "accel_bias_ug", "gyro_scale_ppm", "accel_scale_ppm", "gyro_bias_std_deg_h",
@@ -168,9 +169,13 @@ InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double
     n.Fail("nav_file", "give either nav_file or position_deg_m/velocity_mps/attitude_deg, not both");
   }
   if (x.source == InitConfig::Source::kGiven) {
-    if (!has_file && !has_values) {
-      n.Fail("source", "source: given needs nav_file or position_deg_m, velocity_mps and attitude_deg");
+    if (!has_file && !has_values && !state_on_command_line) {
+      n.Fail("source",
+             "source: given needs nav_file or position_deg_m, velocity_mps and attitude_deg (or --init_from on the "
+             "command line)");
     }
+  }
+  if (x.source == InitConfig::Source::kGiven && (has_file || has_values)) {
     InsState s;
     if (has_file) {
       if (n.Has("time_s")) n.Fail("time_s", "the time comes from nav_file");
@@ -573,7 +578,7 @@ void ObginsVehicle(const ConfigNode& root, GnssInsConfig* c) {
 
 }  // namespace
 
-GnssInsConfig LoadGnssInsConfig(const std::string& path) {
+GnssInsConfig LoadGnssInsConfig(const std::string& path, bool init_state_on_command_line) {
   const ConfigNode root = LoadYamlFile(path);
   root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "nhc", "odometer", "vehicle", "gnss",
                     "outages", "filter", "batch", "output_rate_hz", "start_s", "end_s"});
@@ -586,7 +591,7 @@ GnssInsConfig LoadGnssInsConfig(const std::string& path) {
   c.filter = ParseFilter(root.Child("filter"));
   c.imu_noise = ParseImuNoise(root.Child("imu_noise"), c.filter.scale_factors);
   c.installation = ParseInstallation(root.Child("installation"));
-  c.init = ParseInit(root.Child("init"), path, c.start_time_s);
+  c.init = ParseInit(root.Child("init"), path, c.start_time_s, init_state_on_command_line);
   c.mag = ParseMag(root.Child("mag"));
   if (c.init.heading == InitConfig::Heading::kMagnetometer && c.mag.mode == MagConfig::Mode::kOff) {
     root.Child("init").Fail("heading", "magnetometer needs a magnetometer (mag.mode other than off)");

@@ -60,6 +60,11 @@ struct InitConfig {
   };
   Source source = Source::kGiven;
   std::optional<InsState> state;  ///< required for kGiven (time = start)
+  /// kGiven from a navigation file chosen on the command line (`--init_from`): `state` is
+  /// its record at start_time_s or, without a start, at the start of the IMU record as the
+  /// installation's time offset puts it, which only the inputs know (RunGnssIns fills
+  /// `state` then). Empty: `state` as configured.
+  std::string nav_file_at_start;
   /// kGiven: the position (and the start) from the first GNSS fix at or after the state's
   /// time, velocity and attitude from `state` (OB_GINS starts so).
   bool position_from_gnss = false;
@@ -130,7 +135,10 @@ struct GnssInsConfig {
 
 /// Parses navtwin's YAML configuration (keys in docs/gnss-ins.md). Unknown keys, missing
 /// required keys, non-positive sigmas: InputError naming file, line and key.
-GnssInsConfig LoadGnssInsConfig(const std::string& path);
+/// `init_state_on_command_line`: the initial state comes from elsewhere (`--init_from`,
+/// InitConfig::nav_file_at_start), so `init.source: given` (the default) may come without
+/// nav_file or values; the rest of the init section (stds, IMU errors) still applies.
+GnssInsConfig LoadGnssInsConfig(const std::string& path, bool init_state_on_command_line = false);
 
 /// Reads a KF-GINS YAML configuration unchanged (imupath, gnsspath, outputpath,
 /// imudatalen, imudatarate, starttime, endtime, initpos [deg deg m], initvel [m/s],

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "core/calibration_file.h"
 #include "core/io/input_error.h"
@@ -47,13 +49,52 @@ double IsaAltitude_m(double pressure_pa) {
   return 288.15 / 0.0065 * (1.0 - std::pow(pressure_pa / 101325.0, 1.0 / 5.255877));
 }
 
-std::vector<ImuSample> ReadImu(const std::string& path, const std::string& calibration, double temperature_degC,
+/// The calibration file's parts that apply to a run, and the installation in force.
+struct RunCalibration {
+  std::optional<ImuCalibration> imu;
+  std::optional<MagCorrection> mag;  ///< only when a magnetometer file is read
+  Installation installation;         ///< the configuration's, or the calibration file's
+  bool installation_from_file = false;
+};
+
+/// Reads paths.calibration (empty: the configuration's installation, nothing else). The
+/// file must hold something for this run: an imu or installation section, or a mag section
+/// when a magnetometer is read. Its installation replaces the configuration's mounting and
+/// time offset, which must then be zero: a mounting or offset given twice is refused
+/// rather than composed or overridden silently.
+RunCalibration ReadRunCalibration(const InputPaths& paths, const Installation& configured) {
+  RunCalibration c;
+  c.installation = configured;
+  if (paths.calibration.empty()) return c;
+  const CalibrationFile file = ReadCalibrationFile(paths.calibration);
+  c.imu = file.imu;
+  if (!paths.mag.empty()) c.mag = file.mag;
+  if (!c.imu && !c.mag && !file.installation) {
+    throw InputError(paths.calibration, 0, "imu",
+                     paths.mag.empty() ? "neither an imu nor an installation section: nothing applies to the IMU"
+                                       : "no imu, mag or installation section: nothing to calibrate");
+  }
+  if (file.installation) {
+    if (!configured.imu_mounting_rpy_rad.isZero(0.0) || configured.imu_time_offset_s != 0.0) {
+      throw InputError(paths.calibration, 0, "installation",
+                       "the configuration sets installation.imu_mounting_deg or imu_time_offset_s as well: give the "
+                       "IMU's mounting and time offset in one place (set them to 0 in the configuration)");
+    }
+    c.installation.imu_mounting_rpy_rad = file.installation->mounting_rpy_rad;
+    c.installation.imu_time_offset_s = file.installation->time_offset_s;
+    c.installation_from_file = true;
+  }
+  return c;
+}
+
+std::vector<ImuSample> ReadImu(const std::string& path, const RunCalibration& calibration, double temperature_degC,
                                const GnssInsConfig& config) {
-  const Installation& inst = config.installation;
+  const Installation& inst = calibration.installation;
   const Eigen::Vector3d& rpy = inst.imu_mounting_rpy_rad;
   // v_b = R_b_imu v_imu (config.h, Installation).
   const Eigen::Matrix3d R_b_imu = DcmFromEuler(rpy[0], rpy[1], rpy[2]);
-  auto reader = OpenImu(path, calibration, temperature_degC);
+  auto reader = OpenImu(path);
+  if (calibration.imu) reader = CalibratedImuReader(std::move(reader), *calibration.imu, temperature_degC);
   std::vector<ImuSample> out;
   ImuSample s;
   while (reader->Next(&s)) {
@@ -149,9 +190,10 @@ std::vector<GnssSample> ReadGnss(const std::string& path, double t_begin, double
   return out;
 }
 
-std::vector<MagSample> ReadMag(const std::string& path, const std::string& calibration, double t_begin,
-                               double t_end) {
-  auto reader = OpenMag(path, calibration);
+std::vector<MagSample> ReadMag(const std::string& path, const std::optional<MagCorrection>& calibration,
+                               double t_begin, double t_end) {
+  auto reader = OpenMag(path);
+  if (calibration) reader = CalibratedMagReader(std::move(reader), *calibration);
   std::vector<MagSample> out;
   MagSample m;
   while (reader->Next(&m)) {
@@ -204,21 +246,13 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
   if (paths.imu.empty()) throw InputError("(no file)", 0, "imu", "no IMU file given");
   if (paths.gnss.empty()) throw InputError("(no file)", 0, "gnss", "no GNSS file given");
   // The calibration file's sections that apply (an empty path: none).
-  std::string imu_calibration, mag_calibration;
-  if (!paths.calibration.empty()) {
-    const CalibrationFile file = ReadCalibrationFile(paths.calibration);
-    if (file.imu) imu_calibration = paths.calibration;
-    if (file.mag && !paths.mag.empty()) mag_calibration = paths.calibration;
-    if (imu_calibration.empty() && mag_calibration.empty()) {
-      throw InputError(paths.calibration, 0, "imu",
-                       paths.mag.empty() ? "no imu section: the file does not calibrate the IMU"
-                                         : "neither an imu nor a mag section: nothing to calibrate");
-    }
-  }
+  const RunCalibration calibration = ReadRunCalibration(paths, config.installation);
   Inputs in;
   in.paths = paths;
-  in.imu = BridgeGaps(ReadImu(paths.imu, imu_calibration, paths.imu_temperature_degC, config), paths.imu, config.installation.imu_time_offset_s,
-                      config.filter.max_bridge_gap_s, &in.bridged_imu_gaps);
+  in.installation = calibration.installation;
+  in.installation_from_calibration = calibration.installation_from_file;
+  in.imu = BridgeGaps(ReadImu(paths.imu, calibration, paths.imu_temperature_degC, config), paths.imu,
+                      calibration.installation.imu_time_offset_s, config.filter.max_bridge_gap_s, &in.bridged_imu_gaps);
   const double t_begin = in.imu.front().t_s - in.imu.front().dt_s;
   const double t_end = in.imu.back().t_s;
 
@@ -258,7 +292,7 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
     }
   }
 
-  if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, mag_calibration, t_begin, t_end);
+  if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, calibration.mag, t_begin, t_end);
   if (!paths.baro.empty()) in.baro = ReadBaro(paths.baro, t_begin, t_end);
   if (config.odometer.enabled()) {
     in.odometer = ReadOdometerSpan(config.odometer.from_imu_file ? paths.imu : config.odometer.file, t_begin, t_end);

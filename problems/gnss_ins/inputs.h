@@ -16,14 +16,20 @@ namespace navtwin::gnss_ins {
 struct InputPaths {
   std::string imu, gnss, mag, baro;  ///< mag and baro may be empty
   /// Calibration file (core/calibration_file.h) or empty: its imu section is applied to the
-  /// IMU (in the IMU's own axes, before the mounting), its mag section to the magnetometer;
-  /// it must hold at least one of the two for the files read.
+  /// IMU (in the IMU's own axes, before the mounting), its mag section to the magnetometer,
+  /// its installation section (mounting, time offset) in place of the configuration's
+  /// installation.imu_mounting_deg and imu_time_offset_s, which must then be zero; it must
+  /// hold at least one section for the files read.
   std::string calibration;
   double imu_temperature_degC = NAN;  ///< NaN: the calibration's reference temperature
 };
 
 struct Inputs {
   InputPaths paths;
+  /// The installation applied to the IMU: the configuration's, with the mounting and time
+  /// offset of the calibration file's installation section when it has one.
+  Installation installation;
+  bool installation_from_calibration = false;  ///< the calibration file set the mounting and time offset
   std::vector<ImuSample> imu;     ///< body axes, strictly increasing t_s, dt_s > 0
   std::vector<GnssSample> gnss;   ///< strictly increasing; injected outages removed
   std::vector<MagSample> mag;     ///< raw (calibration is applied by the models' users)

@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "core/io/atomic_file.h"
+#include "core/io/open.h"
 #include "core/rotation.h"
+#include "core/units.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
 #include "problems/gnss_ins/adapted_noise.h"
@@ -24,6 +26,7 @@
 #include "problems/gnss_ins/initial_state.h"
 #include "problems/gnss_ins/output.h"
 #include "problems/gnss_ins/sim_config.h"
+#include "problems/ins/pure_ins.h"
 
 namespace navtwin::gnss_ins {
 namespace {
@@ -128,6 +131,20 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
 
 }  // namespace
 
+/// InitConfig::nav_file_at_start: its record at start_time_s, else at the start of the first
+/// IMU interval (after the installation's time offset); the IMU-error estimates and the
+/// stds stay the configuration's.
+void InitFromNavFile(const Inputs& inputs, GnssInsConfig* config) {
+  const double imu_start_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
+  const double t_s = std::isfinite(config->start_time_s) ? config->start_time_s : imu_start_s;
+  const std::unique_ptr<NavReader> reader = OpenNav(config->init.nav_file_at_start);
+  InsState state;
+  state.nav = InitialStateFromNav(*reader, t_s);
+  config->init.source = InitConfig::Source::kGiven;
+  config->init.position_from_gnss = false;
+  config->init.state = state;
+}
+
 InputSummary SummarizeInputs(const Inputs& inputs) {
   InputSummary s;
   s.paths = inputs.paths;
@@ -153,6 +170,14 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
                       << (p.mag.empty() ? "" : ", " + p.mag) << (p.baro.empty() ? "" : ", " + p.baro) << "\n";
   }
   const Inputs inputs = LoadInputs(p, config);
+  if (inputs.installation_from_calibration && options.progress) {
+    const Eigen::Vector3d rpy_deg = inputs.installation.imu_mounting_rpy_rad * kRadToDeg;
+    char line[256];
+    std::snprintf(line, sizeof line, ": IMU installation from %s: mounting roll %.3f pitch %.3f yaw %.3f deg, time offset %.4f s\n",
+                  p.calibration.c_str(), rpy_deg.x(), rpy_deg.y(), rpy_deg.z(), inputs.installation.imu_time_offset_s);
+    *options.progress << options.command << line;
+  }
+  if (!config.init.nav_file_at_start.empty()) InitFromNavFile(inputs, &config);
   if (config.init.state && std::isnan(config.init.state->nav.t_s)) {
     config.init.state->nav.t_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
   }

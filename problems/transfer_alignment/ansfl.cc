@@ -354,19 +354,6 @@ TransferConfig AnsflDotConfig() {
 
 namespace {
 
-/// The Horizontal folders have no GTExtended.csv, hence no geodetic origin for their N/E/D
-/// offsets. They were flown by the same group (University of Haifa) as the StraightLine
-/// flights, whose take-off point (GTExtended.csv, first row) is used: the origin sets only
-/// the normal gravity and the Earth rate's direction, which change by 1e-5 g and 1e-3 deg/h per
-/// km of error.
-wgs84::Geodetic HorizontalOrigin() {
-  wgs84::Geodetic g;
-  g.lat_rad = 32.8256829718786 * kDegToRad;
-  g.lon_rad = 34.9559595644856 * kDegToRad;
-  g.h_m = 10.1942341;
-  return g;
-}
-
 /// "StraightLine/path_1" from ".../StraightLine/path_1".
 std::string PathLabel(const fs::path& dir) { return (dir.parent_path().filename() / dir.filename()).generic_string(); }
 
@@ -425,9 +412,8 @@ TransferInputs LoadAnsflPath(const std::string& path_dir, int dot, CoarseAlignme
   TransferInputs in;
   in.master_path = (dir / "GT.csv").string();
   in.slave_path = (dir / ("IMU_" + std::to_string(dot) + ".csv")).string();
-  AnsflGtOptions gt_options;
-  if (!fs::exists(dir / "GTExtended.csv")) gt_options.origin = HorizontalOrigin();
-  const std::unique_ptr<NavReader> gt_reader = OpenAnsflGt(in.master_path, gt_options);
+  // Horizontal paths (no GTExtended.csv): the reader's default origin, AnsflSiteOrigin().
+  const std::unique_ptr<NavReader> gt_reader = OpenAnsflGt(in.master_path);
   in.master = ReadAll<NavState>(*gt_reader);
   const std::unique_ptr<ImuReader> imu_reader = OpenAnsflImu(in.slave_path);
   in.slave_imu = ReadAll<ImuSample>(*imu_reader);
@@ -454,45 +440,89 @@ TransferInputs LoadAnsflPath(const std::string& path_dir, int dot, CoarseAlignme
   return in;
 }
 
-std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const TransferConfig& config, Method method) {
-  std::vector<AnsflAlignment> out;
+namespace {
+
+/// One path folder and DOT: coarse alignment and refinement; a failure is a note (one path
+/// or DOT that cannot be aligned, a line-only rotation or a failed solve, is reported, not
+/// fatal for the others).
+AnsflAlignment AlignOneDot(const fs::path& dir, int dot, const TransferConfig& config, Method method) {
+  AnsflAlignment a;
+  a.path = PathLabel(dir);
+  a.dot = dot;
+  a.result.method = method;
+  a.residual_attitude_mrad = std::nan("");
+  std::cerr << "transfer-align-ansfl: " << a.path << " DOT" << dot << " ..." << std::flush;
+  try {
+    TransferInputs in = LoadAnsflPath(dir.string(), dot, &a.coarse);
+    // The GT as body "truth": RunMethod then scores R_n_s M_est^T against it, from which
+    // the residual against the delay-shifted GT is recovered (ResidualAttitudeMrad).
+    in.truth = in.master;
+    a.result = RunMethod(in, config, method);
+    a.residual_attitude_mrad = ResidualAttitudeMrad(in.master, a.result, in.slave_initial.t_s, config.settle_s);
+    if (std::isnan(a.residual_attitude_mrad)) a.note = "no epoch after settle_s";
+    std::cerr << Fmt(" offset %.3f s, delay %.1f ms, residual %.2f mrad\n", a.coarse.clock_offset_s,
+                     a.result.delay_s * 1e3, a.residual_attitude_mrad);
+  } catch (const std::exception& e) {
+    a.note = e.what();
+    std::cerr << " skipped: " << e.what() << "\n";
+  }
+  return a;
+}
+
+}  // namespace
+
+std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const TransferConfig& config, Method method,
+                                          const AnsflSelection& selection) {
   std::vector<fs::path> dirs;
-  for (const char* type : {"StraightLine", "Horizontal"}) {
-    const std::vector<fs::path> d = PathDirs(fs::path(data_dir) / type);
-    dirs.insert(dirs.end(), d.begin(), d.end());
+  if (!selection.path.empty()) {
+    const fs::path dir = fs::path(data_dir) / selection.path;
+    if (!fs::exists(dir / "GT.csv")) {
+      throw InputError((dir / "GT.csv").string(), 0, "path", "no such path folder (give e.g. Horizontal/path_4)");
+    }
+    dirs.push_back(dir);
+  } else {
+    for (const char* type : {"StraightLine", "Horizontal"}) {
+      const std::vector<fs::path> d = PathDirs(fs::path(data_dir) / type);
+      dirs.insert(dirs.end(), d.begin(), d.end());
+    }
   }
   if (dirs.empty()) {
     throw InputError(data_dir, 0, "StraightLine/path_*, Horizontal/path_*", "no path folders under the data directory");
   }
+  std::vector<AnsflAlignment> out;
   for (const fs::path& dir : dirs) {
     for (int dot = 1; dot <= 4; ++dot) {
-      if (!fs::exists(dir / ("IMU_" + std::to_string(dot) + ".csv"))) continue;
-      AnsflAlignment a;
-      a.path = PathLabel(dir);
-      a.dot = dot;
-      a.result.method = method;
-      a.residual_attitude_mrad = std::nan("");
-      std::cerr << "transfer-align-ansfl: " << a.path << " DOT" << dot << " ..." << std::flush;
-      try {
-        TransferInputs in = LoadAnsflPath(dir.string(), dot, &a.coarse);
-        // The GT as body "truth": RunMethod then scores R_n_s M_est^T against it, from which
-        // the residual against the delay-shifted GT is recovered (ResidualAttitudeMrad).
-        in.truth = in.master;
-        a.result = RunMethod(in, config, method);
-        a.residual_attitude_mrad = ResidualAttitudeMrad(in.master, a.result, in.slave_initial.t_s, config.settle_s);
-        if (std::isnan(a.residual_attitude_mrad)) a.note = "no epoch after settle_s";
-        std::cerr << Fmt(" offset %.3f s, delay %.1f ms, residual %.2f mrad\n", a.coarse.clock_offset_s,
-                         a.result.delay_s * 1e3, a.residual_attitude_mrad);
-      } catch (const std::exception& e) {
-        // One path or DOT that cannot be aligned (a line-only rotation, a failed solve) is
-        // reported, not fatal for the others.
-        a.note = e.what();
-        std::cerr << " skipped: " << e.what() << "\n";
+      if (selection.dot != 0 && dot != selection.dot) continue;
+      const fs::path imu = dir / ("IMU_" + std::to_string(dot) + ".csv");
+      if (!fs::exists(imu)) {
+        if (selection.dot != 0) throw InputError(imu.string(), 0, "dot", "no such DOT file in this path folder");
+        continue;
       }
-      out.push_back(a);
+      out.push_back(AlignOneDot(dir, dot, config, method));
     }
   }
   return out;
+}
+
+CalibrationFile AnsflCalibrationFile(const AnsflAlignment& a, const std::string& created_by) {
+  if (!AnsflRefined(a)) {
+    throw std::invalid_argument("no calibration for " + a.path + " DOT" + std::to_string(a.dot) + ": " + a.note);
+  }
+  const auto sigma_or_nan = [](double s) { return s > 0.0 && std::isfinite(s) ? s : std::nan(""); };
+  CalibrationFile f;
+  f.created_by = created_by;
+  ImuCalibration imu;
+  imu.gyro.tail<3>() = a.coarse.gyro_bias_s_radps;
+  f.imu = imu;
+  ImuInstallation inst;
+  inst.mounting_rpy_rad = a.result.misalignment_deg * kDegToRad;
+  inst.time_offset_s = a.coarse.clock_offset_s + a.result.delay_s;
+  Vector3d mounting_sigma_rad;
+  for (int i = 0; i < 3; ++i) mounting_sigma_rad[i] = sigma_or_nan(a.result.misalignment_sigma_mrad[i] * kMrad_rad);
+  inst.mounting_sigma_rad = mounting_sigma_rad;
+  inst.time_offset_sigma_s = sigma_or_nan(a.result.delay_sigma_s);
+  f.installation = inst;
+  return f;
 }
 
 bool AnsflCoarseOk(const AnsflAlignment& a) { return a.coarse.correlation > 0.0; }

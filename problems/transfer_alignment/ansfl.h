@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "core/calibration_file.h"
 #include "problems/transfer_alignment/config.h"
 #include "problems/transfer_alignment/inputs.h"
 #include "problems/transfer_alignment/run.h"
@@ -61,14 +62,32 @@ struct AnsflAlignment {
 /// ansfl.cc and docs/transfer-alignment-real.md).
 TransferConfig AnsflDotConfig();
 
+/// Which paths and DOTs to align (defaults: all).
+struct AnsflSelection {
+  std::string path;  ///< a path folder relative to the data directory, e.g. "Horizontal/path_4"; empty: all
+  int dot = 0;       ///< 1-4; 0: every IMU_k.csv of the path
+};
+
 /// Every StraightLine/path_* and Horizontal/path_* under data_dir and every IMU_k.csv in
-/// it, with the given method. Progress on stderr.
-std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const TransferConfig& config, Method method);
+/// it (or the selected ones: InputError when the selected folder or DOT file is missing),
+/// with the given method. Progress on stderr.
+std::vector<AnsflAlignment> AlignAllAnsfl(const std::string& data_dir, const TransferConfig& config, Method method,
+                                          const AnsflSelection& selection = {});
 
 /// The coarse step succeeded (CoarseAlignAnsfl set a correlation > 0 at its peak).
 bool AnsflCoarseOk(const AnsflAlignment& a);
 /// The refinement gave a mounting and delay (no note, or only "no epoch after settle_s").
 bool AnsflRefined(const AnsflAlignment& a);
+
+/// The calibration file of one refined alignment (docs/calibration-file.md), for
+/// `smooth --calibration`: installation = the refined mounting R_b_s (ZYX Euler) and the time
+/// offset clock_offset_s + delay_s (the DOT sample tagged t_dot belongs to GT.csv's time
+/// t_dot + offset + delay: the GT record tagged t carries the drone's state at t - delay),
+/// with the refinement's sigmas (the delay's covers the coarse offset's error: it is
+/// estimated around it); imu.gyro.bias_rad_per_s = the coarse gyro bias (DOT axes), which
+/// the calibration removes before the mounting turns the DOT into body axes.
+/// std::invalid_argument when the alignment was not refined (AnsflRefined).
+CalibrationFile AnsflCalibrationFile(const AnsflAlignment& a, const std::string& created_by);
 
 /// Mean, sample standard deviation (n - 1; NaN for one value) and max - min of values; NaN
 /// for none. Angles (rad) that may wrap at +-pi (the DOT roll is near pi) are first brought

@@ -159,14 +159,17 @@ std::string GtText(int rows) {
   return text;
 }
 
-TEST(AnsflTest, GtWithoutExtendedUsesZeroOriginAndDifferencedVelocity) {
+TEST(AnsflTest, GtWithoutExtendedUsesTheSiteOriginAndDifferencedVelocity) {
   const std::string dir = MakeTempDir();
   const std::vector<NavState> s =
       ReadAllSamples(*OpenAnsflGt(WriteFile(dir + "/GT.csv", GtText(5))));
   ASSERT_EQ(s.size(), 5u);
   EXPECT_EQ(s[0].gps_week, -1);
-  EXPECT_NEAR(s[0].lat_rad, 0.0, 1e-15);
-  EXPECT_NEAR(s[4].h_m, 0.2, 1e-6);  // -Down; WGS84 curvature over 0.9 m: < 1e-6 m
+  // The first row (N = E = D = 0) is the site origin itself.
+  EXPECT_NEAR(s[0].lat_rad, AnsflSiteOrigin().lat_rad, 1e-12);  // through ECEF and back
+  EXPECT_NEAR(s[0].lon_rad, AnsflSiteOrigin().lon_rad, 1e-12);
+  // -Down above the site; WGS84 curvature over 0.9 m: < 1e-6 m.
+  EXPECT_NEAR(s[4].h_m, AnsflSiteOrigin().h_m + 0.2, 1e-6);
   for (const NavState& n : s) {
     // Differences of positions printed to 1e-6 m over 0.1-0.2 s: 1e-5 m/s.
     EXPECT_NEAR(n.v_n_mps.x(), 2.0, 1e-5);
