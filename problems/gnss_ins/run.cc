@@ -129,8 +129,6 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
   RunAdaptedFilter(sinks, start, run);
 }
 
-}  // namespace
-
 /// InitConfig::nav_file_at_start: its record at start_time_s, else at the start of the first
 /// IMU interval (after the installation's time offset); the IMU-error estimates and the
 /// stds stay the configuration's.
@@ -144,6 +142,8 @@ void InitFromNavFile(const Inputs& inputs, GnssInsConfig* config) {
   config->init.position_from_gnss = false;
   config->init.state = state;
 }
+
+}  // namespace
 
 InputSummary SummarizeInputs(const Inputs& inputs) {
   InputSummary s;
