@@ -15,6 +15,7 @@
 #include "core/io/csv_mag_baro.h"
 #include "core/io/input_error.h"
 #include "core/io/open.h"
+#include "tests/scratch_dir.h"
 
 namespace navtwin {
 namespace core_calibration_file_test {
@@ -22,24 +23,7 @@ namespace core_calibration_file_test {
 using Triad = Eigen::Matrix<double, kTriadParameters, 1>;
 using GSens = Eigen::Matrix<double, kGSensitivityParameters, 1>;
 
-class CalibrationFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = ::testing::TempDir() + "calibration_file_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir_, ignored);
-  }
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = dir_ + "/" + name;
-    std::ofstream(path) << text;
-    return path;
-  }
-  std::string dir_;
-};
+class CalibrationFileTest : public testing::ScratchDirTest {};
 
 /// A triad of errors of a tactical IMU: scale factors and misalignments of ~1e-3, bias `b`.
 Triad RandomTriad(std::mt19937& rng, double b) {

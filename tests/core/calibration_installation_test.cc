@@ -14,28 +14,12 @@
 #include "core/calibration_file.h"
 #include "core/io/csv_imu.h"
 #include "core/io/input_error.h"
+#include "tests/scratch_dir.h"
 
 namespace navtwin {
 namespace core_calibration_installation_test {
 
-class CalibrationInstallationTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = ::testing::TempDir() + "calibration_installation_" +
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    std::filesystem::remove_all(dir_, ignored);
-  }
-  std::string Write(const std::string& name, const std::string& text) {
-    const std::string path = dir_ + "/" + name;
-    std::ofstream(path) << text;
-    return path;
-  }
-  std::string dir_;
-};
+class CalibrationInstallationTest : public testing::ScratchDirTest {};
 
 /// A DOT-like installation: 180 deg roll (z up), a few degrees, a 0.4 s clock offset.
 ImuInstallation DotInstallation() {

@@ -306,17 +306,23 @@ TEST(ImuPreintegration, BiasJacobiansMatchReintegration) {
   EXPECT_LT(num_R_ba.norm(), 1e-12);  // the rotation does not depend on ba
 }
 
+/// Biases and scale factors of a consumer IMU to linearise at (1500-3000 ppm).
+ImuErrors NonZeroLinearisation() {
+  ImuErrors lin;
+  lin.bg_radps = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
+  lin.ba_mps2 = Eigen::Vector3d(0.02, -0.01, 0.03);
+  lin.sg = Eigen::Vector3d(1500e-6, -800e-6, 2000e-6);
+  lin.sa = Eigen::Vector3d(-1200e-6, 900e-6, 3000e-6);
+  return lin;
+}
+
 // The scale-factor Jacobians, and the bias Jacobians at non-zero scale factors (where the
 // bias enters divided by 1 + s), against central differences of Reintegrate. Steps 1e-5:
 // truncation h^2 |d3/ds3| / 6 with |d3 dv/ds3| ~ 6 |dv| < 200 gives 3e-9, rounding
 // eps |dv| / h < 1e-9, against Jacobians of O(1 .. 30).
 TEST(ImuPreintegration, ScaleFactorJacobiansMatchReintegration) {
   const Record rec = MakeRecord(Flight(kFast), 4.0);
-  ImuErrors lin;
-  lin.bg_radps = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
-  lin.ba_mps2 = Eigen::Vector3d(0.02, -0.01, 0.03);
-  lin.sg = Eigen::Vector3d(1500e-6, -800e-6, 2000e-6);
-  lin.sa = Eigen::Vector3d(-1200e-6, 900e-6, 3000e-6);
+  const ImuErrors lin = NonZeroLinearisation();
   const auto pre = Preintegrate(rec.imu, 2.0, 3.0, lin, kArw, kVrw);
   using Member = Eigen::Vector3d ImuErrors::*;
   // Central differences of (rotation, velocity, position) in one member of the errors.
@@ -573,11 +579,7 @@ TEST(ImuPreintegration, FactorJacobianMatchesCentralDifferences) {
 // evaluated at others (steps 1e-6 on the scale factors: whitened changes of 1e-3).
 TEST(ImuPreintegration, ScaleFactorJacobianMatchesCentralDifferences) {
   const Record rec = MakeRecord(Flight(kFast), 12.0);
-  ImuErrors lin;
-  lin.bg_radps = Eigen::Vector3d(1e-3, -2e-3, 5e-4);
-  lin.ba_mps2 = Eigen::Vector3d(0.02, -0.01, 0.03);
-  lin.sg = Eigen::Vector3d(1500e-6, -800e-6, 2000e-6);
-  lin.sa = Eigen::Vector3d(-1200e-6, 900e-6, 3000e-6);
+  const ImuErrors lin = NonZeroLinearisation();
   const auto pre = Preintegrate(rec.imu, 10.003, 11.003, lin, kArw, kVrw);
   const std::unique_ptr<ceres::CostFunction> cost(CreateImuScaleFactor(pre));
   ASSERT_EQ(cost->num_residuals(), 9);
