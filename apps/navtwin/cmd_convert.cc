@@ -12,10 +12,16 @@
 // (core/io/nav_as_gnss.h), so a reference solution can aid `smooth` / `navigate`. For the
 // ANSFL files the flags default to kAnsflReferencePosSigma_m / kAnsflReferenceVelSigma_mps
 // (core/io/ansfl.h gives the reasoning); other navigation files need them stated.
+//
+// Navigation streams also go to other people's tools (core/io/track_export.h): `--to kml`
+// (Google Earth; `--std std.csv --ellipse_sigma K` adds K-sigma horizontal ellipses every
+// --ellipse_interval_s), `--to gpx`, `--to pos` (RTKLIB, for rtkplot; needs --std for its
+// sigma columns). The format follows the output's extension when --to is not given.
 #include <gflags/gflags.h>
 
 #include <cmath>
 #include <iostream>
+#include <stdexcept>
 #include <utility>
 
 #include "apps/navtwin/command.h"
@@ -29,13 +35,21 @@
 #include "core/io/nav_as_gnss.h"
 #include "core/io/open.h"
 #include "core/io/ulog.h"
+#include "core/io/track_export.h"
 #include "core/io/ulog_time.h"
 
 DEFINE_string(in, "", "Input file (any format `navtwin info` knows)");
 DEFINE_string(what, "",
               "Stream to convert: imu, gnss, nav, mag, baro or px4_estimate (ULog: PX4's own "
               "estimate, the same as nav) (default: the file's main stream)");
-DEFINE_string(to, "", "Output format: kfgins or csv (default: csv for a .csv output, else kfgins; mag and baro: csv)");
+DEFINE_string(to, "",
+              "Output format: kfgins or csv; for navigation streams also kml, gpx or pos (RTKLIB) (default: from "
+              "the output's extension .csv/.kml/.gpx/.pos, else kfgins; mag and baro: csv)");
+DEFINE_string(std, "",
+              "A run's std.csv with the navigation file's sigmas (--to pos: required, its sigma columns; --to kml: "
+              "for --ellipse_sigma)");
+DEFINE_double(ellipse_sigma, 0.0, "--to kml: draw the K-sigma horizontal position ellipse (0: none; needs --std)");
+DEFINE_double(ellipse_interval_s, 1.0, "--to kml: one ellipse at least this many seconds apart");
 DEFINE_double(pos_sigma_m, NAN,
               "convert --what gnss from a navigation file: position sigma per axis of the fixes, m (ANSFL "
               "GT.csv/GTExtended.csv default 0.1; required for other navigation files)");
@@ -141,6 +155,58 @@ void ReportAnsflReference(FileFormat f, const NavAsGnssOptions& o) {
   }
 }
 
+std::size_t WriteTrack(NavReader& reader, const std::string& to);
+
+/// Writes a navigation stream in `to` (kfgins, kml, gpx, pos); returns the epoch count. A
+/// state the format cannot hold (no GPS week for .pos) is an error naming the input file.
+std::size_t WriteNav(NavReader& reader, const std::string& to) {
+  if (to == "kfgins") {
+    KfginsNavWriter writer(FLAGS_out);
+    return CopyAll(reader, writer);
+  }
+  try {
+    return WriteTrack(reader, to);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(FLAGS_in, 0, "t_s", e.what());
+  }
+}
+
+/// kml, gpx or pos, with the sigmas of --std.
+std::size_t WriteTrack(NavReader& reader, const std::string& to) {
+  NavStdSeries sigmas;
+  if (!FLAGS_std.empty()) sigmas = ReadNavStdCsv(FLAGS_std);
+  const auto sigma_at = [&](const NavState& s) -> long {
+    if (FLAGS_std.empty()) return -1;
+    const long row = sigmas.Find(s.t_s);
+    if (row < 0 && to == "pos") {
+      throw InputError(FLAGS_std, 0, "t_s", "no row at t = " + std::to_string(s.t_s) + " s of " + FLAGS_in);
+    }
+    return row;
+  };
+  std::size_t n = 0;
+  NavState s;
+  if (to == "pos") {
+    RtklibPosWriter writer(FLAGS_out, FLAGS_in);
+    for (; reader.Next(&s); ++n) {
+      const long row = sigma_at(s);
+      writer.Write(s, sigmas.pos_ned_m[row], sigmas.vel_ned_mps[row]);
+    }
+    writer.Commit();
+  } else if (to == "kml") {
+    KmlWriter writer(FLAGS_out, FLAGS_in, FLAGS_ellipse_sigma, FLAGS_ellipse_interval_s);
+    for (; reader.Next(&s); ++n) {
+      const long row = sigma_at(s);
+      writer.Write(s, row >= 0 ? &sigmas.pos_ned_m[row] : nullptr);
+    }
+    writer.Commit();
+  } else {
+    GpxWriter writer(FLAGS_out, FLAGS_in);
+    for (; reader.Next(&s); ++n) writer.Write(s);
+    writer.Commit();
+  }
+  return n;
+}
+
 /// Converts one stream; returns the sample count. `to` is checked already.
 std::size_t ConvertStream(const std::string& what, const std::string& to, const InputTime& time) {
   const std::string note = time.Note(FLAGS_in);
@@ -178,8 +244,7 @@ std::size_t ConvertStream(const std::string& what, const std::string& to, const 
   }
   if (time.ulog) {  // nav or px4_estimate from a ULog: PX4's own estimate
     auto reader = OpenULogPx4Estimate(FLAGS_in);
-    KfginsNavWriter writer(FLAGS_out);
-    const std::size_t n = CopyAll(*reader, writer);
+    const std::size_t n = WriteNav(*reader, to);
     ReportEstimate(reader->stats());
     return n;
   }
@@ -189,19 +254,35 @@ std::size_t ConvertStream(const std::string& what, const std::string& to, const 
                          FormatName(DetectFormat(FLAGS_in)));
   }
   auto reader = OpenNav(FLAGS_in);
-  KfginsNavWriter writer(FLAGS_out);
-  return CopyAll(*reader, writer);
+  return WriteNav(*reader, to);
 }
 
 /// The output format, or "" with *why set when the stream cannot be written so.
 std::string OutputFormat(const std::string& what, std::string* why) {
   const bool csv_only = what == "mag" || what == "baro";
-  const bool kfgins_only = what == "gnss" || what == "nav" || what == "px4_estimate";
+  const bool nav = what == "nav" || what == "px4_estimate";
   std::string to = FLAGS_to;
-  if (to.empty()) to = csv_only || EndsWith(FLAGS_out, ".csv") ? "csv" : "kfgins";
-  if (to != "kfgins" && to != "csv") *why = "--to must be kfgins or csv";
+  if (to.empty()) {
+    to = csv_only || EndsWith(FLAGS_out, ".csv") ? "csv" : "kfgins";
+    for (const char* ext : {"kml", "gpx", "pos"}) {
+      if (nav && EndsWith(FLAGS_out, std::string(".") + ext)) to = ext;
+    }
+  }
+  const bool track = to == "kml" || to == "gpx" || to == "pos";
+  if (to != "kfgins" && to != "csv" && !track) *why = "--to must be kfgins, csv, kml, gpx or pos";
   if (csv_only && to != "csv") *why = "magnetometer and barometer streams are written as csv only";
-  if (kfgins_only && to != "kfgins") *why = "GNSS and navigation streams are written as kfgins only";
+  if (what == "gnss" && to != "kfgins") *why = "GNSS streams are written as kfgins only";
+  if (nav && to != "kfgins" && !track) *why = "navigation streams are written as kfgins, kml, gpx or pos";
+  if (track && !nav) *why = "kml, gpx and pos are written from navigation streams (--what nav)";
+  if (to == "pos" && FLAGS_std.empty()) *why = "--to pos needs --std (a run's std.csv) for RTKLIB's sigma columns";
+  if (FLAGS_ellipse_sigma != 0.0 && (to != "kml" || FLAGS_std.empty())) {
+    *why = "--ellipse_sigma goes with --to kml and --std";
+  }
+  if (!(FLAGS_ellipse_sigma >= 0.0) || !std::isfinite(FLAGS_ellipse_sigma) || !(FLAGS_ellipse_interval_s >= 0.0) ||
+      !std::isfinite(FLAGS_ellipse_interval_s)) {
+    *why = "--ellipse_sigma and --ellipse_interval_s must be finite and >= 0";
+  }
+  if (!FLAGS_std.empty() && !track) *why = "--std goes with --to kml or --to pos";
   return why->empty() ? to : "";
 }
 
@@ -278,10 +359,11 @@ int RunConvert(const std::vector<std::string>& args) {
 
 Command ConvertCommand() {
   return {"convert",
-          "Convert between formats (ULog, RTKLIB, CSV, drone files -> KF-GINS or CSV; PX4's estimate)",
-          "navtwin convert --in F --out F [--what imu|gnss|nav|mag|baro|px4_estimate] [--to kfgins|csv] "
+          "Convert between formats (ULog, RTKLIB, CSV, drone files -> KF-GINS or CSV; PX4's estimate; navigation -> KML, GPX, RTKLIB .pos)",
+          "navtwin convert --in F --out F [--what imu|gnss|nav|mag|baro|px4_estimate] "
+          "[--to kfgins|csv|kml|gpx|pos] [--std STD_CSV [--ellipse_sigma K [--ellipse_interval_s S]]] "
           "[--pos_sigma_m S --vel_sigma_mps S (gnss from a navigation file)] [--format=json]",
-          {"in", "out", "what", "to", "pos_sigma_m", "vel_sigma_mps"},
+          {"in", "out", "what", "to", "std", "ellipse_sigma", "ellipse_interval_s", "pos_sigma_m", "vel_sigma_mps"},
           &RunConvert};
 }
 
