@@ -36,13 +36,15 @@ using transfer::TransferResult;
 
 const char* kUsage =
     "navtwin transfer-align --master F --slave_imu F --init_from NAV [--start_s T] [--truth NAV] "
-    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|batch|all [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|batch|all [--out DIR] [--format=json]\n"
     "       navtwin transfer-align --scenario PRESET|YAML [--seed S] [--delay_s X] [--config YAML] "
-    "--method order1|order2|batch|all [--format=json]\n"
+    "--method order1|order2|batch|all [--out DIR] [--format=json]\n"
     "  The slave starts from the record of --init_from at or after --start_s (default: the start of the\n"
     "  slave IMU data), its mounting unknown (identity guess). Attitude errors need --truth (a scenario\n"
     "  brings its own, with the true mounting and delay). Configuration keys: data/configs/\n"
-    "  transfer-alignment-high-maneuver.yaml. --method all runs the three (JSON: an array of three objects).";
+    "  transfer-alignment-high-maneuver.yaml. --method all runs the three (JSON: an array of three objects).\n"
+    "  --out DIR writes the run folder: summary.json and per method the estimates and attitude errors\n"
+    "  against time (docs/run-folder.md).";
 
 int Usage(const std::string& why) {
   std::cerr << "navtwin transfer-align: " << why << "\nusage: " << kUsage << "\n";
@@ -110,7 +112,12 @@ int RunTransferAlign(const std::vector<std::string>& args) {
     std::fprintf(stderr, "transfer-align: %s done in %.2f s\n", transfer::MethodName(m), results.back().run_time_s);
   }
 
-  // Every result exists before anything is printed: no partial output on failure.
+  // Every result exists before anything is printed or written: no partial output on failure.
+  if (!FLAGS_out.empty()) {
+    transfer::WriteTransferRunFolder(FLAGS_out, results);
+    std::cerr << "transfer-align: run folder " << FLAGS_out << " (summary.json, <method>/estimates.csv"
+              << (inputs.truth.empty() ? "" : ", <method>/attitude_errors.csv") << ")\n";
+  }
   if (FLAGS_format == "json") {
     if (results.size() == 1) {
       std::cout << transfer::TransferResultJson(results.front()) << "\n";
@@ -136,7 +143,7 @@ Command TransferAlignCommand() {
           "Transfer alignment with misalignment and delay estimation (seed 002): order1, order2 or batch",
           kUsage,
           {"master", "slave_imu", "init_from", "start_s", "truth", "config", "scenario", "seed", "delay_s", "method",
-           "calibration", "imu_temperature_degC"},
+           "calibration", "imu_temperature_degC", "out"},
           &RunTransferAlign};
 }
 

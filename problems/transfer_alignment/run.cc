@@ -60,6 +60,10 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
   // The filter's misalignment estimate changes along the run; each epoch is scored with the
   // R_n_s it had (the misalignment only enters the body-truth fallback, which uses the last).
   ScoreAttitude(inputs, states, last.misalignment, config.settle_s, &r);
+  for (const TransferEpoch& e : run.epochs) {
+    r.estimates.push_back({e.t_s, EulerOf(e.misalignment) * kRadToDeg, e.sigma.segment<3>(6) / kMrad_rad, e.delay_s,
+                           e.sigma[9]});
+  }
   r.delay_s = last.delay_s;
   r.delay_sigma_s = last.sigma[9];
   r.misalignment_deg = EulerOf(last.misalignment) * kRadToDeg;
@@ -80,6 +84,9 @@ TransferResult RunBatchMethod(const TransferInputs& inputs, const TransferConfig
   r.delay_sigma_s = sol.delay_sigma_s;
   r.misalignment_deg = EulerOf(sol.misalignment) * kRadToDeg;
   r.misalignment_sigma_mrad = sol.misalignment_sigma_rad / kMrad_rad;
+  for (const NavState& state : sol.states) {
+    r.estimates.push_back({state.t_s, r.misalignment_deg, r.misalignment_sigma_mrad, r.delay_s, r.delay_sigma_s});
+  }
   std::ostringstream note;
   note << (r.note.empty() ? "" : "; ") << "batch: " << sol.states.size() << " states, " << sol.iterations
        << " iterations, final cost " << sol.final_cost;

@@ -40,6 +40,16 @@ struct TransferResult {
   /// Per epoch: t_s and the attitude error (mrad) for plots.
   std::vector<double> t_s;
   std::vector<Eigen::Vector3d> error_mrad;
+  /// The misalignment and delay estimates with their sigma after each update (filters), or
+  /// the batch's one estimate at each of its states, for plots of their convergence.
+  struct Estimate {
+    double t_s = 0.0;
+    Eigen::Vector3d misalignment_deg = Eigen::Vector3d::Zero();  ///< ZYX Euler of R_b_s
+    Eigen::Vector3d misalignment_sigma_mrad = Eigen::Vector3d::Zero();
+    double delay_s = 0.0;
+    double delay_sigma_s = 0.0;
+  };
+  std::vector<Estimate> estimates;
 };
 
 /// Fills r's attitude scores from slave states (t_s, q_n_b = R_n_s estimate): per state the
@@ -58,5 +68,13 @@ TransferResult RunMethod(const TransferInputs& inputs, const TransferConfig& con
 /// "delay_sigma_s":..,"misalignment_deg":[..],"run_time_s":..} plus extra keys; NaN -> null.
 std::string TransferResultJson(const TransferResult& r);
 std::string TransferResultTable(const TransferResult& r);
+
+/// The run folder of `transfer-align --out DIR` (docs/run-folder.md): DIR/summary.json
+/// {"command":"transfer-align","methods":{"<method>":TransferResultJson,...}}, and per
+/// method DIR/<method>/estimates.csv (t_s, misalignment roll/pitch/yaw deg and their sigma
+/// mrad, delay and its sigma s) and, with a truth, DIR/<method>/attitude_errors.csv (t_s,
+/// roll/pitch/heading error mrad). Every file is written whole and renamed into place at
+/// the end (a failure leaves no file); the folders are created as needed.
+void WriteTransferRunFolder(const std::string& dir, const std::vector<TransferResult>& results);
 
 }  // namespace navtwin::transfer

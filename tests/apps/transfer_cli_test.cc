@@ -101,6 +101,48 @@ TEST(TransferCliTest, ScenarioJsonHasTheIssuesKeys) {
   EXPECT_NE(r.err.find("transfer delay 0.2 s"), std::string::npos) << r.err;
 }
 
+/// Rows of a CSV file (the header excluded) and its header.
+std::size_t DataRows(const std::string& text, std::string* header) {
+  *header = text.substr(0, text.find('\n'));
+  std::size_t rows = 0;
+  for (char c : text) rows += c == '\n' ? 1 : 0;
+  return rows - 1;
+}
+
+// --out DIR: summary.json with the three methods, per method the estimates against time
+// (a row per update for the filters, per state for the batch, whose one estimate every row
+// repeats) and the attitude errors, with the same last estimate as summary.json.
+TEST(TransferCliTest, OutWritesTheRunFolder) {
+  const std::string d = Folder();
+  const std::string out = MakeTempDir("transfer_run") + "/run";
+  const RunResult r = Navtwin("transfer-align --scenario " + d + "/short.yaml --seed 1 --config " + d +
+                              "/settle.yaml --method all --format=json --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = ReadAll(out + "/summary.json");
+  EXPECT_EQ(summary.rfind("{\"command\":\"transfer-align\",\"methods\":{\"order1\":{\"method\":\"order1\"", 0), 0u)
+      << summary;
+  for (const char* method : {"order1", "order2", "batch"}) {
+    std::string header;
+    const std::string estimates = ReadAll(out + "/" + method + "/estimates.csv");
+    EXPECT_GT(DataRows(estimates, &header), 10u) << method;
+    EXPECT_EQ(header,
+              "t_s,mis_roll_deg,mis_pitch_deg,mis_yaw_deg,mis_roll_std_mrad,mis_pitch_std_mrad,mis_yaw_std_mrad,"
+              "delay_s,delay_std_s");
+    // The last row's delay is the reported estimate (printed to 17 digits in both).
+    const std::string last = estimates.substr(estimates.rfind('\n', estimates.size() - 2) + 1);
+    double t = 0, m[6], delay = NAN;
+    ASSERT_EQ(std::sscanf(last.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &t, &m[0], &m[1], &m[2], &m[3], &m[4],
+                          &m[5], &delay),
+              8)
+        << last;
+    const std::string anchor = std::string("\"") + method + "\":{";
+    EXPECT_NEAR(delay, JsonNumberAfter(summary, anchor, "delay_est_s"), 1e-9) << method;
+    const std::string errors = ReadAll(out + "/" + method + "/attitude_errors.csv");
+    EXPECT_GT(DataRows(errors, &header), 10u) << method;
+    EXPECT_EQ(header, "t_s,roll_err_mrad,pitch_err_mrad,heading_err_mrad");
+  }
+}
+
 TEST(TransferCliTest, FilesWithAndWithoutTruth) {
   const std::string d = Folder();
   const std::string files =
