@@ -15,6 +15,8 @@
 
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
+#include "core/io/atomic_file.h"
+#include "core/io/folder.h"
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
@@ -90,9 +92,9 @@ std::string OutlierText(const sim::Scenario& s) {
 
 const char* kAlignUsage =
     "navtwin inflight-align --imu F --gnss F [--baro F] --init_from NAV [--start_s T] [--truth NAV] "
-    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method distance|kalman|batch|all [--track_csv F] [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method distance|kalman|batch|all [--track_csv F] [--out DIR] [--format=json]\n"
     "       navtwin inflight-align --scenario PRESET|YAML [--seed S] [--outlier_fraction P --outlier_m M] "
-    "[--config YAML] --method distance|kalman|batch|all [--track_csv F] [--format=json]\n"
+    "[--config YAML] --method distance|kalman|batch|all [--track_csv F] [--out DIR] [--format=json]\n"
     "  The initial state is the record of --init_from at or after --start_s (default its first record);\n"
     "  heading errors need --truth (a scenario brings its own). Configuration keys: data/configs/\n"
     "  inflight-mach07-south.yaml. --method all runs the three (JSON: an array of the three objects).";
@@ -103,6 +105,26 @@ std::string TaggedPath(const std::string& path, const std::string& tag) {
   const std::size_t dot = path.find_last_of('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return path + "_" + tag;
   return path.substr(0, dot) + "_" + tag + path.substr(dot);
+}
+
+/// --out DIR (docs/run-folder.md): DIR/summary.json {"command":"inflight-align","methods":
+/// {"<method>":MethodResultJson,...}} and DIR/<method>/track.csv per method.
+void WriteInflightRunFolder(const std::vector<MethodResult>& results) {
+  EnsureFolder(FLAGS_out);
+  for (const MethodResult& r : results) {
+    const std::string dir = FLAGS_out + "/" + inflight::MethodName(r.method);
+    EnsureFolder(dir);
+    inflight::WriteTrackCsv(r, dir + "/track.csv");
+  }
+  AtomicFile summary(FLAGS_out + "/summary.json");
+  summary.stream() << "{\"command\":\"inflight-align\",\"methods\":{";
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    summary.stream() << (i ? "," : "") << '"' << inflight::MethodName(results[i].method)
+                     << "\":" << inflight::MethodResultJson(results[i]);
+  }
+  summary.stream() << "}}\n";
+  summary.Commit();
+  std::cerr << "inflight-align: run folder " << FLAGS_out << " (summary.json, <method>/track.csv)\n";
 }
 
 int RunInflightAlign(const std::vector<std::string>& args) {
@@ -172,6 +194,7 @@ int RunInflightAlign(const std::vector<std::string>& args) {
       inflight::WriteTrackCsv(r, path);
     }
   }
+  if (!FLAGS_out.empty()) WriteInflightRunFolder(results);
   if (FLAGS_format == "json") {
     if (results.size() == 1) {
       std::cout << inflight::MethodResultJson(results.front()) << "\n";
@@ -318,7 +341,7 @@ Command InflightAlignCommand() {
           "In-flight heading alignment from the distance flown (seed 003): distance, kalman or batch",
           kAlignUsage,
           {"imu", "gnss", "baro", "init_from", "start_s", "truth", "config", "scenario", "seed", "method",
-           "track_csv", "outlier_fraction", "outlier_m", "calibration", "imu_temperature_degC"},
+           "track_csv", "outlier_fraction", "outlier_m", "calibration", "imu_temperature_degC", "out"},
           &RunInflightAlign};
 }
 

@@ -1,7 +1,4 @@
 // WriteTransferRunFolder (run.h): the run folder of `transfer-align --out DIR`.
-#include <sys/stat.h>
-
-#include <cerrno>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -9,20 +6,11 @@
 #include <vector>
 
 #include "core/io/atomic_file.h"
+#include "core/io/folder.h"
 #include "problems/transfer_alignment/run.h"
 
 namespace navtwin::transfer {
 namespace {
-
-/// Creates `dir` unless it exists as a folder.
-void EnsureFolder(const std::string& dir) {
-  struct stat st;
-  if (::stat(dir.c_str(), &st) == 0) {
-    if (!S_ISDIR(st.st_mode)) throw std::runtime_error(dir + " exists and is not a folder");
-    return;
-  }
-  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw std::runtime_error("cannot create the folder " + dir);
-}
 
 /// A number as the run folders write them: shortest round-trip form, "nan" for NaN.
 std::string CsvNumber(double x) {

@@ -86,6 +86,29 @@ TEST(InflightCliTest, FilesWithTruthWriteTheTrack) {
   std::remove(csv.c_str());
 }
 
+// --out DIR: summary.json with every method, and each method's track (the same rows as
+// --track_csv writes).
+TEST(InflightCliTest, OutWritesTheRunFolder) {
+  const std::string d = SimulatedDir();
+  const std::string out = MakeTempDir("inflight_run") + "/run";
+  const RunResult r = Navtwin("inflight-align --imu " + d + "/imu.txt --gnss " + d + "/gnss.txt --baro " + d +
+                              "/baro.csv --init_from " + d + "/init.nav --truth " + d +
+                              "/truth.nav --method all --out " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = ReadAll(out + "/summary.json");
+  EXPECT_EQ(summary.rfind("{\"command\":\"inflight-align\",\"methods\":{\"distance\":{", 0), 0u) << summary;
+  for (const char* method : {"distance", "kalman", "batch"}) {
+    EXPECT_NE(summary.find(std::string("\"") + method + "\":{"), std::string::npos) << method;
+    std::istringstream in(ReadAll(out + "/" + method + "/track.csv"));
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "t_s,path_length_km,yaw_deg,sigma_arcmin,error_arcmin") << method;
+    int rows = 0;
+    while (std::getline(in, line)) ++rows;
+    EXPECT_GT(rows, 500) << method;  // one per 1 Hz fix of the 545 s flight
+  }
+}
+
 TEST(InflightCliTest, MalformedGnssNamesFileAndLineAndWritesNothing) {
   const std::string d = SimulatedDir();
   // Line 101 cut short (a truncated record in the middle of the file).

@@ -1,0 +1,19 @@
+#include "core/io/folder.h"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <stdexcept>
+
+namespace navtwin {
+
+void EnsureFolder(const std::string& dir) {
+  struct stat st;
+  if (::stat(dir.c_str(), &st) == 0) {
+    if (!S_ISDIR(st.st_mode)) throw std::runtime_error(dir + " exists and is not a folder");
+    return;
+  }
+  if (::mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) throw std::runtime_error("cannot create the folder " + dir);
+}
+
+}  // namespace navtwin
