@@ -1,5 +1,6 @@
 #include "problems/report/html.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -12,7 +13,7 @@ body{font-family:system-ui,-apple-system,"Segoe UI","DejaVu Sans",sans-serif;mar
 padding:1em 2em;color:#222;line-height:1.45;background:#fff}
 h1{font-size:1.6em;margin-bottom:.2em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:2em}
 h3{margin-bottom:.3em}
-table{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em}
+table{border-collapse:collapse;margin:.5em 0 1em;font-size:.9em;display:block;overflow-x:auto;max-width:100%}
 th,td{border:1px solid #ccc;padding:.25em .6em;text-align:right;white-space:nowrap}
 th{background:#f0f3f7}td.name,th.name{text-align:left}tr:nth-child(even) td{background:#fafafa}
 td.bad{background:#fde2e1!important;color:#a00;font-weight:600}
@@ -71,16 +72,16 @@ std::string InputsSection(const std::vector<RunData>& runs) {
                   Head({"folder", "command", "output", "IMU samples", "GNSS epochs", "removed by outages", "outages",
                         "span [s]", "reference"});
   for (const RunData& r : runs) {
-    const YAML::Node in = r.summary["inputs"];
+    const YAML::Node in = JsonChild(r.summary, "inputs");
     const std::string p = r.summary_path;
-    s += "<tr>" + NameCell(r.dir) + NameCell(r.summary["command"] ? r.summary["command"].Scalar() : "") +
-         NameCell(r.output_method) + Cell(JsonNumber(in["imu_samples"], p, "inputs.imu_samples"), "%.0f") +
-         Cell(JsonNumber(in["gnss_epochs"], p, "inputs.gnss_epochs"), "%.0f") +
-         Cell(JsonNumber(in["gnss_removed_by_outages"], p, "inputs.gnss_removed_by_outages"), "%.0f") +
+    s += "<tr>" + NameCell(r.dir) + NameCell(JsonChild(r.summary, "command") ? JsonChild(r.summary, "command").Scalar() : "") +
+         NameCell(r.output_method) + Cell(JsonNumber(JsonChild(in, "imu_samples"), p, "inputs.imu_samples"), "%.0f") +
+         Cell(JsonNumber(JsonChild(in, "gnss_epochs"), p, "inputs.gnss_epochs"), "%.0f") +
+         Cell(JsonNumber(JsonChild(in, "gnss_removed_by_outages"), p, "inputs.gnss_removed_by_outages"), "%.0f") +
          Cell(static_cast<double>(r.outages.size()), "%.0f") +
-         Cell(JsonNumber(in["t_end_s"], p, "inputs.t_end_s") - JsonNumber(in["t_start_s"], p, "inputs.t_start_s"),
+         Cell(JsonNumber(JsonChild(in, "t_end_s"), p, "inputs.t_end_s") - JsonNumber(JsonChild(in, "t_start_s"), p, "inputs.t_start_s"),
               "%.1f") +
-         NameCell(r.summary["truth"] ? r.summary["truth"].Scalar() : "none") + "</tr>\n";
+         NameCell(JsonChild(r.summary, "truth") ? JsonChild(r.summary, "truth").Scalar() : "none") + "</tr>\n";
   }
   return s + "</table>\n";
 }
@@ -88,7 +89,7 @@ std::string InputsSection(const std::vector<RunData>& runs) {
 std::string WarningsSection(const std::vector<RunData>& runs) {
   std::string items;
   for (const RunData& r : runs) {
-    for (const YAML::Node& w : r.summary["warnings"]) {
+    for (const YAML::Node& w : JsonChild(r.summary, "warnings")) {
       items += "<li>" + HtmlEscape((runs.size() > 1 ? r.label + ": " : "") + w.Scalar()) + "</li>\n";
     }
   }
@@ -99,22 +100,22 @@ std::string WarningsSection(const std::vector<RunData>& runs) {
 std::string ErrorsTable(const std::vector<RunData>& runs) {
   std::string rows;
   for (const RunData& r : runs) {
-    for (const auto& kv : r.summary["methods"]) {
-      const YAML::Node e = kv.second["errors"];
+    for (const auto& kv : JsonChild(r.summary, "methods")) {
+      const YAML::Node e = JsonChild(kv.second, "errors");
       if (!e) continue;
-      const YAML::Node all = e["all"];
+      const YAML::Node all = JsonChild(e, "all");
       const std::string k = "methods." + kv.first.Scalar() + ".errors.";
       rows += "<tr>" + NameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) +
-              Cell(Num(r, all["horizontal_m"]["rms"], k + "all.horizontal_m.rms")) +
-              Cell(Num(r, all["horizontal_m"]["max"], k + "all.horizontal_m.max")) +
-              Cell(Num(r, all["vertical_m"]["rms"], k + "all.vertical_m.rms")) +
-              Cell(Num(r, all["velocity_rms_mps"], k + "all.velocity_rms_mps")) +
-              Cell(Num(r, all["roll_deg"]["rms"], k + "all.roll_deg.rms")) +
-              Cell(Num(r, all["pitch_deg"]["rms"], k + "all.pitch_deg.rms")) +
-              Cell(Num(r, all["yaw_deg"]["rms"], k + "all.yaw_deg.rms")) +
-              Cell(Num(r, e["outage_horizontal_rms_m"], k + "outage_horizontal_rms_m")) +
-              Cell(Num(r, e["outage_vertical_rms_m"], k + "outage_vertical_rms_m")) +
-              Cell(Num(r, kv.second["run_time_s"], "methods." + kv.first.Scalar() + ".run_time_s"), "%.2f") + "</tr>\n";
+              Cell(Num(r, JsonChild(JsonChild(all, "horizontal_m"), "rms"), k + "all.horizontal_m.rms")) +
+              Cell(Num(r, JsonChild(JsonChild(all, "horizontal_m"), "max"), k + "all.horizontal_m.max")) +
+              Cell(Num(r, JsonChild(JsonChild(all, "vertical_m"), "rms"), k + "all.vertical_m.rms")) +
+              Cell(Num(r, JsonChild(all, "velocity_rms_mps"), k + "all.velocity_rms_mps")) +
+              Cell(Num(r, JsonChild(JsonChild(all, "roll_deg"), "rms"), k + "all.roll_deg.rms")) +
+              Cell(Num(r, JsonChild(JsonChild(all, "pitch_deg"), "rms"), k + "all.pitch_deg.rms")) +
+              Cell(Num(r, JsonChild(JsonChild(all, "yaw_deg"), "rms"), k + "all.yaw_deg.rms")) +
+              Cell(Num(r, JsonChild(e, "outage_horizontal_rms_m"), k + "outage_horizontal_rms_m")) +
+              Cell(Num(r, JsonChild(e, "outage_vertical_rms_m"), k + "outage_vertical_rms_m")) +
+              Cell(Num(r, JsonChild(kv.second, "run_time_s"), "methods." + kv.first.Scalar() + ".run_time_s"), "%.2f") + "</tr>\n";
     }
   }
   if (rows.empty()) return "<p class=\"note\">No errors: the runs had no reference (--truth).</p>\n";
@@ -131,20 +132,20 @@ std::string ConsistencyTable(const std::vector<RunData>& runs) {
   static const char* const kKeys[9] = {"pos_n", "pos_e", "pos_d", "vel_n", "vel_e", "vel_d", "roll", "pitch", "yaw"};
   std::string rows;
   for (const RunData& r : runs) {
-    for (const auto& kv : r.summary["methods"]) {
-      const YAML::Node c = kv.second["errors"]["consistency"];
+    for (const auto& kv : JsonChild(r.summary, "methods")) {
+      const YAML::Node c = JsonChild(JsonChild(kv.second, "errors"), "consistency");
       if (!c) continue;
       for (const char* scope : {"all", "inside_outages"}) {
-        const YAML::Node s = c[scope];
+        const YAML::Node s = JsonChild(c, scope);
         if (!s) continue;
         const std::string k = "methods." + kv.first.Scalar() + ".errors.consistency." + scope + ".";
         rows += "<tr>" + NameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) + NameCell(scope) +
-                Cell(Num(r, s["epochs"], k + "epochs"), "%.0f");
+                Cell(Num(r, JsonChild(s, "epochs"), k + "epochs"), "%.0f");
         for (const char* key : kKeys) {
-          const double v = Num(r, s[key], k + key);
+          const double v = Num(r, JsonChild(s, key), k + key);
           rows += Cell(v, "%.2f", Dishonest(v));
         }
-        rows += Cell(Num(r, s["pos_nees_mean"], k + "pos_nees_mean"), "%.2f") + "</tr>\n";
+        rows += Cell(Num(r, JsonChild(s, "pos_nees_mean"), k + "pos_nees_mean"), "%.2f") + "</tr>\n";
       }
     }
   }
@@ -158,23 +159,23 @@ std::string ConsistencyTable(const std::vector<RunData>& runs) {
 std::string ResidualsTable(const std::vector<RunData>& runs) {
   std::string rows;
   for (const RunData& r : runs) {
-    for (const auto& kv : r.summary["methods"]) {
+    for (const auto& kv : JsonChild(r.summary, "methods")) {
       const std::string m = kv.first.Scalar();
-      for (const auto& g : kv.second["residuals"]) {
+      for (const auto& g : JsonChild(kv.second, "residuals")) {
         const YAML::Node v = g.second;
         const std::string k = "methods." + m + ".residuals." + g.first.Scalar() + ".";
-        const double dof = Num(r, v["dof"], k + "dof");
-        const double configured = v["configured_chi2_per_dof"] && !v["configured_chi2_per_dof"].IsNull()
-                                      ? Num(r, v["configured_chi2_per_dof"], k + "configured_chi2_per_dof")
-                                      : Num(r, v["chi2_per_dof"], k + "chi2_per_dof");
-        const bool adapted = v["adapted"] && v["adapted"].Scalar() == "true";
-        const YAML::Node count = kv.second["counts"][g.first.Scalar()];
+        const double dof = Num(r, JsonChild(v, "dof"), k + "dof");
+        const double configured = JsonChild(v, "configured_chi2_per_dof") && !JsonChild(v, "configured_chi2_per_dof").IsNull()
+                                      ? Num(r, JsonChild(v, "configured_chi2_per_dof"), k + "configured_chi2_per_dof")
+                                      : Num(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof");
+        const bool adapted = JsonChild(v, "adapted") && JsonChild(v, "adapted").Scalar() == "true";
+        const YAML::Node count = JsonChild(JsonChild(kv.second, "counts"), g.first.Scalar());
         rows += "<tr>" + NameCell(MethodName(r, m, runs.size() > 1)) + NameCell(g.first.Scalar()) +
-                Cell(Num(r, v["rows"], k + "rows"), "%.0f") + Cell(dof, "%.1f") +
-                Cell(count ? Num(r, count["rejected"], "counts.rejected") : std::nan(""), "%.0f") +
+                Cell(Num(r, JsonChild(v, "rows"), k + "rows"), "%.0f") + Cell(dof, "%.1f") +
+                Cell(count ? Num(r, JsonChild(count, "rejected"), "counts.rejected") : std::nan(""), "%.0f") +
                 Cell(dof >= 1.0 ? configured : std::nan(""), "%.3f", dof >= 10.0 && configured > 3.0) +
-                Cell(adapted ? Num(r, v["sigma_scale"], k + "sigma_scale") : std::nan(""), "%.3f") +
-                Cell(adapted ? Num(r, v["chi2_per_dof"], k + "chi2_per_dof") : std::nan(""), "%.3f") + "</tr>\n";
+                Cell(adapted ? Num(r, JsonChild(v, "sigma_scale"), k + "sigma_scale") : std::nan(""), "%.3f") +
+                Cell(adapted ? Num(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof") : std::nan(""), "%.3f") + "</tr>\n";
       }
     }
   }
@@ -227,40 +228,54 @@ std::string Base64(const std::string& bytes) {
 
 namespace {
 
-/// One parameter row: per method "value ± std" (scale factors in ppm), "not observable" in red.
-std::string ParameterRow(const RunData& r, const std::string& m, const std::string& kind, const std::string& name,
-                         const YAML::Node& p, bool several) {
+/// One parameter of one method: "value ± σ" (scale factors in ppm), "not observable" in red.
+std::string ParameterCell(const RunData& r, const std::string& m, const std::string& kind, const std::string& name) {
+  const YAML::Node p = JsonChild(JsonChild(JsonChild(JsonChild(r.summary, "methods"), m), kind), name);
+  if (!p) return "<td>–</td>";
   const double scale = kind == "imu_scale_factors" ? 1e6 : 1.0;
   const std::string k = "methods." + m + "." + kind + "." + name + ".";
-  const bool observable = !p["observable"] || p["observable"].Scalar() != "false";
-  std::string row = "<tr>" + NameCell(MethodName(r, m, several)) + NameCell(name + (scale != 1.0 ? " [ppm]" : ""));
-  row += Cell(Num(r, p["value"], k + "value") * scale, "%.6g") + Cell(Num(r, p["std"], k + "std") * scale, "%.3g") +
-         Cell(Num(r, p["prior_std"], k + "prior_std") * scale, "%.3g");
-  row += observable ? "<td class=\"name\">yes</td>"
-                    : "<td class=\"bad\">not observable (σ ≥ 0.9 × prior σ)</td>";
-  return row + "</tr>\n";
+  const double value = Num(r, JsonChild(p, "value"), k + "value") * scale, std = Num(r, JsonChild(p, "std"), k + "std") * scale;
+  if (JsonChild(p, "observable") && JsonChild(p, "observable").Scalar() == "false") {
+    return "<td class=\"bad\">not observable (" + Fmt("%.4g", value) + " ± " + Fmt("%.2g", std) + ")</td>";
+  }
+  return "<td>" + Fmt("%.4g", value) + " ± " + Fmt("%.2g", std) + "</td>";
 }
 
+/// Per folder: one row per parameter (auxiliary states, IMU scale factors), one column per method.
 std::string ParametersTable(const std::vector<RunData>& runs) {
-  std::string rows;
+  std::string out;
   for (const RunData& r : runs) {
-    for (const auto& kv : r.summary["methods"]) {
+    std::vector<std::string> methods;
+    std::vector<std::pair<std::string, std::string>> params;  // kind, name
+    for (const auto& kv : JsonChild(r.summary, "methods")) {
+      methods.push_back(kv.first.Scalar());
       for (const char* kind : {"aux", "imu_scale_factors"}) {
-        for (const auto& p : kv.second[kind]) {
-          rows += ParameterRow(r, kv.first.Scalar(), kind, p.first.Scalar(), p.second, runs.size() > 1);
+        for (const auto& p : JsonChild(kv.second, kind)) {
+          const std::pair<std::string, std::string> key{kind, p.first.Scalar()};
+          if (std::find(params.begin(), params.end(), key) == params.end()) params.push_back(key);
         }
       }
     }
+    if (params.empty()) continue;
+    std::vector<std::string> head = {"parameter"};
+    head.insert(head.end(), methods.begin(), methods.end());
+    out += (runs.size() > 1 ? "<p>" + HtmlEscape(r.label) + ":</p>" : std::string()) + "<table>" + Head(head);
+    for (const auto& [kind, name] : params) {
+      out += "<tr>" + NameCell(name + (kind == "imu_scale_factors" ? " [ppm]" : ""));
+      for (const std::string& m : methods) out += ParameterCell(r, m, kind, name);
+      out += "</tr>\n";
+    }
+    out += "</table>\n";
   }
-  if (rows.empty()) return "<p class=\"note\">No estimated parameters (auxiliary states, IMU scale factors).</p>\n";
-  return "<h3>Estimated parameters at the end of the record (aiding-source states in SI units, IMU scale factors)</h3>\n"
-         "<table>" + Head({"method", "parameter", "value", "σ", "prior σ", "observable"}) + rows + "</table>\n";
+  if (out.empty()) return "<p class=\"note\">No estimated parameters (auxiliary states, IMU scale factors).</p>\n";
+  return "<h3>Estimated parameters at the end of the record (value ± σ; aiding-source states in SI units, IMU scale "
+         "factors in ppm; not observable: σ ≥ 0.9 × prior σ)</h3>\n" + out;
 }
 
 std::string AdaptedNoiseList(const std::vector<RunData>& runs) {
   std::string items;
   for (const RunData& r : runs) {
-    for (const YAML::Node& line : r.summary["adapted_noise"]) {
+    for (const YAML::Node& line : JsonChild(r.summary, "adapted_noise")) {
       items += "<li><code>" + HtmlEscape((runs.size() > 1 ? r.label + ": " : "") + line.Scalar()) + "</code></li>\n";
     }
   }

@@ -44,8 +44,8 @@ YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path) {
 
 std::vector<Outage> ReadOutages(const YAML::Node& summary, const std::string& path) {
   std::vector<Outage> out;
-  const YAML::Node list = summary["outages"];
-  if (!list) return out;
+  const YAML::Node list = JsonChild(summary, "outages");
+  if (list.IsNull()) return out;
   if (!list.IsSequence()) throw InputError(path, MarkLine(list), "outages", "expected an array of [start, end]");
   for (const YAML::Node& pair : list) {
     if (!pair.IsSequence() || pair.size() != 2) {
@@ -249,6 +249,12 @@ double JsonNumber(const YAML::Node& node, const std::string& path, const std::st
   return value;
 }
 
+YAML::Node JsonChild(const YAML::Node& node, const std::string& key) {
+  if (!node || !node.IsMap()) return YAML::Node();
+  const YAML::Node child = node[key];
+  return child ? child : YAML::Node();
+}
+
 std::array<double, 2> ChiSquareBounds95(int dof) {
   return {ChiSquareQuantile(0.025, dof), ChiSquareQuantile(0.975, dof)};
 }
@@ -260,11 +266,10 @@ RunData LoadRunFolder(const std::string& dir, const std::string& label, bool lab
   run.label = label;
   run.summary_path = dir + "/summary.json";
   run.summary = ReadSummaryJson(dir, run.summary_path);
-  run.output_method = run.summary["output_method"] ? run.summary["output_method"].as<std::string>() : "";
+  run.output_method = JsonChild(run.summary, "output_method").Scalar();
   run.outages = ReadOutages(run.summary, run.summary_path);
-  run.t_start_s = run.summary["inputs"] ? JsonNumber(run.summary["inputs"]["t_start_s"], run.summary_path,
-                                                     "inputs.t_start_s")
-                                        : std::nan("");
+  run.t_start_s =
+      JsonNumber(JsonChild(JsonChild(run.summary, "inputs"), "t_start_s"), run.summary_path, "inputs.t_start_s");
   const std::string gnss = dir + "/gnss.csv";
   if (IsFile(gnss)) {
     const CsvTable csv(gnss, {{"t_s"}, {"lat_deg"}, {"lon_deg"}, {"in_outage"}});

@@ -93,6 +93,10 @@ RunData LoadRunFolder(const std::string& dir, const std::string& label, bool lab
 /// key for anything else that is not a number.
 double JsonNumber(const YAML::Node& node, const std::string& path, const std::string& key);
 
+/// node[key] when node is an object holding key, else a null node (never yaml-cpp's invalid
+/// node, which throws when indexed further): summary.json's optional keys nest.
+YAML::Node JsonChild(const YAML::Node& node, const std::string& key);
+
 /// The two-sided 95 % bounds of χ² with `dof` degrees of freedom: {2.5 %, 97.5 %} quantiles.
 std::array<double, 2> ChiSquareBounds95(int dof);
 
