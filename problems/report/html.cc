@@ -51,10 +51,11 @@ std::string Cell(double x, const char* format = "%.4g", bool bad = false) {
 
 std::string NameCell(const std::string& text) { return "<td class=\"name\">" + HtmlEscape(text) + "</td>"; }
 
-std::string Head(const std::vector<std::string>& names) {
+/// The header row; the first `text_columns` columns hold names (left-aligned).
+std::string Head(const std::vector<std::string>& names, std::size_t text_columns = 1) {
   std::string s = "<tr>";
   for (std::size_t i = 0; i < names.size(); ++i) {
-    s += std::string(i == 0 ? "<th class=\"name\">" : "<th>") + HtmlEscape(names[i]) + "</th>";
+    s += std::string(i < text_columns ? "<th class=\"name\">" : "<th>") + HtmlEscape(names[i]) + "</th>";
   }
   return s + "</tr>\n";
 }
@@ -70,7 +71,7 @@ double Num(const RunData& run, const YAML::Node& node, const std::string& key) {
 std::string InputsSection(const std::vector<RunData>& runs) {
   std::string s = "<h2 id=\"inputs\">Runs</h2>\n<table>" +
                   Head({"folder", "command", "output", "IMU samples", "GNSS epochs", "removed by outages", "outages",
-                        "span [s]", "reference"});
+                        "span [s]", "reference"}, 3);
   for (const RunData& r : runs) {
     const YAML::Node in = JsonChild(r.summary, "inputs");
     const std::string p = r.summary_path;
@@ -151,8 +152,8 @@ std::string ConsistencyTable(const std::vector<RunData>& runs) {
   }
   if (rows.empty()) return "";
   return "<h3>err/σ (RMS; 1 = honest σ; red beyond 3 or below 1/3) and mean position NEES (expected 3)</h3>\n<table>" +
-         Head({"method", "epochs", "count", "pos N", "pos E", "pos D", "vel N", "vel E", "vel D", "roll", "pitch",
-               "yaw", "NEES pos"}) +
+         Head({"method", "scope", "epochs", "pos N", "pos E", "pos D", "vel N", "vel E", "vel D", "roll", "pitch",
+               "yaw", "NEES pos"}, 2) +
          rows + "</table>\n";
 }
 
@@ -182,7 +183,7 @@ std::string ResidualsTable(const std::vector<RunData>& runs) {
   if (rows.empty()) return "";
   return "<h3>Residual statistics (whitened; χ²/dof near 1 when the noise fits; batch: σ scale from the variance "
          "components)</h3>\n<table>" +
-         Head({"method", "group", "rows", "dof", "rejected", "χ²/dof configured", "σ scale", "χ²/dof adapted"}) + rows +
+         Head({"method", "group", "rows", "dof", "rejected", "χ²/dof configured", "σ scale", "χ²/dof adapted"}, 2) + rows +
          "</table>\n";
 }
 

@@ -45,9 +45,16 @@ ReportSummary WriteReport(const ReportOptions& options) {
     runs.push_back(LoadRunFolder(options.run_dirs[i], labels[i], options.run_dirs.size() > 1, options.max_points,
                                  options.jobs));
   }
+  const auto elapsed_s = [&start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   FigureSet set = BuildFigures(runs);
-  if (options.progress) *options.progress << "report: drawing " << set.figures.size() << " figures with gnuplot\n";
+  if (options.progress) {
+    *options.progress << "report: read in " << elapsed_s() << " s; drawing " << set.figures.size()
+                      << " figures with gnuplot\n";
+  }
   RenderFigures(&set.figures, options.jobs);
+  if (options.progress) *options.progress << "report: drawn at " << elapsed_s() << " s\n";
   AtomicFile out(options.out_path);
   out.stream() << ReportHtml(runs, set.figures, set.left_out);
   out.Commit();
@@ -55,7 +62,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
   summary.figures = set.figures.size();
   summary.left_out = set.left_out;
   for (const RunData& r : runs) summary.left_out.insert(summary.left_out.end(), r.notes.begin(), r.notes.end());
-  summary.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.run_time_s = elapsed_s();
   return summary;
 }
 
