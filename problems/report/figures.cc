@@ -159,8 +159,10 @@ Figure TrackFigure(const std::vector<RunData>& runs, const std::vector<Entry>& e
   if (plots.rfind(", ", 0) == 0) plots = plots.substr(2);
   f.script += Common() + "set size ratio -1\nset xlabel 'east [m]'\nset ylabel 'north [m]'\n"
               "set key outside right top\nplot " + plots + "\n";
+  bool fixes = false;
+  for (const RunData& r : runs) fixes = fixes || (r.has_gnss && !r.gnss.t.empty());
   f.caption = "East and north of each method's navigation solution (nav.csv) and of the GNSS fixes (gnss.csv), in "
-              "metres from the first fix (" + Fmt("%.7f", origin.lat_rad * kRadToDeg) + "°, " +
+              "metres from the first " + std::string(fixes ? "GNSS fix" : "navigation epoch (no gnss.csv)") + " (" + Fmt("%.7f", origin.lat_rad * kRadToDeg) + "°, " +
               Fmt("%.7f", origin.lon_rad * kRadToDeg) + "°). Red crosses: fixes removed by the injected outages "
               "(the outage spans). Points thinned uniformly to at most a few thousand per series.";
   return f;
