@@ -35,7 +35,7 @@ std::vector<Entry> Entries(const std::vector<RunData>& runs) {
   return out;
 }
 
-std::string Fmt(const char* format, double x) {
+std::string FigureText(const char* format, double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, x);
   return buf;
@@ -48,7 +48,7 @@ double TimeOrigin(const std::vector<RunData>& runs) {
 }
 
 std::string TimeLabel(double t0) {
-  return t0 == 0.0 ? "time [s]" : "time since " + Fmt("%.3f", t0) + " s [s]";
+  return t0 == 0.0 ? "time [s]" : "time since " + FigureText("%.3f", t0) + " s [s]";
 }
 
 std::vector<double> Shifted(const std::vector<double>& t, double t0) {
@@ -63,8 +63,8 @@ std::string OutageShading(const std::vector<RunData>& runs, double t0) {
   int k = 1;
   for (const RunData& run : runs) {
     for (const Outage& o : run.outages) {
-      s += "set object " + std::to_string(k++) + " rect from " + Fmt("%.9g", o.start_s - t0) + ", graph 0 to " +
-           Fmt("%.9g", o.end_s - t0) + ", graph 1 fc rgb '#e4e4e4' fs solid 1.0 noborder behind\n";
+      s += "set object " + std::to_string(k++) + " rect from " + FigureText("%.9g", o.start_s - t0) + ", graph 0 to " +
+           FigureText("%.9g", o.end_s - t0) + ", graph 1 fc rgb '#e4e4e4' fs solid 1.0 noborder behind\n";
     }
   }
   return s;
@@ -162,8 +162,8 @@ Figure TrackFigure(const std::vector<RunData>& runs, const std::vector<Entry>& e
   bool fixes = false;
   for (const RunData& r : runs) fixes = fixes || (r.has_gnss && !r.gnss.t.empty());
   f.caption = "East and north of each method's navigation solution (nav.csv) and of the GNSS fixes (gnss.csv), in "
-              "metres from the first " + std::string(fixes ? "GNSS fix" : "navigation epoch (no gnss.csv)") + " (" + Fmt("%.7f", origin.lat_rad * kRadToDeg) + "°, " +
-              Fmt("%.7f", origin.lon_rad * kRadToDeg) + "°). Red crosses: fixes removed by the injected outages "
+              "metres from the first " + std::string(fixes ? "GNSS fix" : "navigation epoch (no gnss.csv)") + " (" + FigureText("%.7f", origin.lat_rad * kRadToDeg) + "°, " +
+              FigureText("%.7f", origin.lon_rad * kRadToDeg) + "°). Red crosses: fixes removed by the injected outages "
               "(the outage spans). Points thinned uniformly to at most a few thousand per series.";
   return f;
 }
@@ -201,7 +201,7 @@ std::string ErrorPanel(const std::vector<Entry>& entries, int c, double t0, Figu
              entries[i].color + "' title " + GnuplotQuote(m.label);
     f->series += 2;
   }
-  std::string s = limit > 0.0 ? "set yrange [" + Fmt("%.6g", -1.15 * limit) + ":" + Fmt("%.6g", 1.15 * limit) + "]\n"
+  std::string s = limit > 0.0 ? "set yrange [" + FigureText("%.6g", -1.15 * limit) + ":" + FigureText("%.6g", 1.15 * limit) + "]\n"
                               : "set autoscale y\n";
   return s + "plot " + plots + "\n";
 }
@@ -286,7 +286,7 @@ struct SensorEntry {
 std::string BoundsText(const BoundsCount& c) {
   if (c.values == 0) return "no values";
   const double outside = 100.0 * static_cast<double>(c.below + c.above) / static_cast<double>(c.values);
-  return Fmt("%.1f %% outside", outside) + " (" + std::to_string(c.below) + " below, " + std::to_string(c.above) +
+  return FigureText("%.1f %% outside", outside) + " (" + std::to_string(c.below) + " below, " + std::to_string(c.above) +
          " above, of " + std::to_string(c.values) + ")";
 }
 
@@ -324,8 +324,8 @@ Figure NisFigure(const std::string& sensor, const std::vector<SensorEntry>& list
   for (std::size_t k = 0; k < shown; ++k) {
     const std::array<double, 2> b = ChiSquareBounds95(dofs[k]);
     const std::string style = " w l lw 1.5 dt " + std::to_string(kDash[k]) + " lc rgb '#000000' ";
-    plots += ", " + Fmt("%.6g", b[0]) + style + "title " +
-             GnuplotQuote("χ²(" + std::to_string(dofs[k]) + ") 95 % bounds") + ", " + Fmt("%.6g", b[1]) + style +
+    plots += ", " + FigureText("%.6g", b[0]) + style + "title " +
+             GnuplotQuote("χ²(" + std::to_string(dofs[k]) + ") 95 % bounds") + ", " + FigureText("%.6g", b[1]) + style +
              "notitle";
     f.series += 2;
   }
@@ -377,13 +377,13 @@ void NeesFigure(const std::vector<RunData>& runs, const std::vector<Entry>& entr
     return;
   }
   const std::array<double, 2> b = ChiSquareBounds95(3);
-  plots += ", " + Fmt("%.6g", b[0]) + " w l lw 1.5 dt 2 lc rgb '#000000' title 'χ²(3) 95 % bounds', " +
-           Fmt("%.6g", b[1]) + " w l lw 1.5 dt 2 lc rgb '#000000' notitle";
+  plots += ", " + FigureText("%.6g", b[0]) + " w l lw 1.5 dt 2 lc rgb '#000000' title 'χ²(3) 95 % bounds', " +
+           FigureText("%.6g", b[1]) + " w l lw 1.5 dt 2 lc rgb '#000000' notitle";
   f.series += 2;
   f.script += "plot " + plots + "\n";
   f.caption = "Position NEES at every compared epoch: Σ (error/σ)² over north, east, down with diagonal σ (combined "
               "with the reference's σ when it has one), log scale, against the two-sided 95 % bounds of χ²(3) (" +
-              Fmt("%.3f", b[0]) + ", " + Fmt("%.3f", b[1]) + "). " + counts +
+              FigureText("%.3f", b[0]) + ", " + FigureText("%.3f", b[1]) + "). " + counts +
               ". Thinned keeping each bucket's extremes; the counts are over every epoch." + OutageNote(runs);
   out->figures.push_back(std::move(f));
 }
@@ -414,16 +414,16 @@ void DriftFigure(const std::vector<RunData>& runs, const std::vector<Entry>& ent
   f.script = Common() + "set style data histogram\nset style histogram clustered gap 1\n"
              "set style fill solid 0.85 noborder\nset boxwidth 0.9\nset yrange [0:*]\n"
              "set ylabel 'max horizontal error in the outage [m]'\nset xlabel " +
-             GnuplotQuote("outage: start – end [s]" + (t0 == 0.0 ? "" : " since " + Fmt("%.3f", t0) + " s")) + "\nset xtics rotate by -30\n";
+             GnuplotQuote("outage: start – end [s]" + (t0 == 0.0 ? "" : " since " + FigureText("%.3f", t0) + " s")) + "\nset xtics rotate by -30\n";
   f.script += "$d << EOD\n";
   for (const Outage& o : spans) {
-    f.script += "\"" + Fmt("%.1f", o.start_s - t0) + "–" + Fmt("%.1f", o.end_s - t0) + "\"";
+    f.script += "\"" + FigureText("%.1f", o.start_s - t0) + "–" + FigureText("%.1f", o.end_s - t0) + "\"";
     for (const Entry* e : plotted) {
       double v = std::nan("");
       for (std::size_t k = 0; k < e->run->outages.size(); ++k) {
         if (std::abs(e->run->outages[k].start_s - o.start_s) < 1e-6) v = e->m->outage_max_horizontal_m[k];
       }
-      f.script += std::isfinite(v) ? " " + Fmt("%.9g", v) : " NaN";
+      f.script += std::isfinite(v) ? " " + FigureText("%.9g", v) : " NaN";
     }
     f.script += "\n";
   }

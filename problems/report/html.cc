@@ -37,7 +37,7 @@ window.addEventListener('load', function () {
 });
 </script>)";
 
-std::string Fmt(const char* format, double x) {
+std::string CellText(const char* format, double x) {
   if (!std::isfinite(x)) return "–";
   char buf[64];
   std::snprintf(buf, sizeof buf, format, x);
@@ -46,7 +46,7 @@ std::string Fmt(const char* format, double x) {
 
 /// A number cell; `bad` marks it.
 std::string Cell(double x, const char* format = "%.4g", bool bad = false) {
-  return std::string(bad ? "<td class=\"bad\">" : "<td>") + Fmt(format, x) + "</td>";
+  return std::string(bad ? "<td class=\"bad\">" : "<td>") + CellText(format, x) + "</td>";
 }
 
 std::string NameCell(const std::string& text) { return "<td class=\"name\">" + HtmlEscape(text) + "</td>"; }
@@ -64,7 +64,7 @@ std::string MethodName(const RunData& run, const std::string& method, bool sever
   return several ? run.label + "/" + method : method;
 }
 
-double Num(const RunData& run, const YAML::Node& node, const std::string& key) {
+double SummaryNumber(const RunData& run, const YAML::Node& node, const std::string& key) {
   return JsonNumber(node, run.summary_path, key);
 }
 
@@ -107,16 +107,16 @@ std::string ErrorsTable(const std::vector<RunData>& runs) {
       const YAML::Node all = JsonChild(e, "all");
       const std::string k = "methods." + kv.first.Scalar() + ".errors.";
       rows += "<tr>" + NameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) +
-              Cell(Num(r, JsonChild(JsonChild(all, "horizontal_m"), "rms"), k + "all.horizontal_m.rms")) +
-              Cell(Num(r, JsonChild(JsonChild(all, "horizontal_m"), "max"), k + "all.horizontal_m.max")) +
-              Cell(Num(r, JsonChild(JsonChild(all, "vertical_m"), "rms"), k + "all.vertical_m.rms")) +
-              Cell(Num(r, JsonChild(all, "velocity_rms_mps"), k + "all.velocity_rms_mps")) +
-              Cell(Num(r, JsonChild(JsonChild(all, "roll_deg"), "rms"), k + "all.roll_deg.rms")) +
-              Cell(Num(r, JsonChild(JsonChild(all, "pitch_deg"), "rms"), k + "all.pitch_deg.rms")) +
-              Cell(Num(r, JsonChild(JsonChild(all, "yaw_deg"), "rms"), k + "all.yaw_deg.rms")) +
-              Cell(Num(r, JsonChild(e, "outage_horizontal_rms_m"), k + "outage_horizontal_rms_m")) +
-              Cell(Num(r, JsonChild(e, "outage_vertical_rms_m"), k + "outage_vertical_rms_m")) +
-              Cell(Num(r, JsonChild(kv.second, "run_time_s"), "methods." + kv.first.Scalar() + ".run_time_s"), "%.2f") + "</tr>\n";
+              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "horizontal_m"), "rms"), k + "all.horizontal_m.rms")) +
+              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "horizontal_m"), "max"), k + "all.horizontal_m.max")) +
+              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "vertical_m"), "rms"), k + "all.vertical_m.rms")) +
+              Cell(SummaryNumber(r, JsonChild(all, "velocity_rms_mps"), k + "all.velocity_rms_mps")) +
+              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "roll_deg"), "rms"), k + "all.roll_deg.rms")) +
+              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "pitch_deg"), "rms"), k + "all.pitch_deg.rms")) +
+              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "yaw_deg"), "rms"), k + "all.yaw_deg.rms")) +
+              Cell(SummaryNumber(r, JsonChild(e, "outage_horizontal_rms_m"), k + "outage_horizontal_rms_m")) +
+              Cell(SummaryNumber(r, JsonChild(e, "outage_vertical_rms_m"), k + "outage_vertical_rms_m")) +
+              Cell(SummaryNumber(r, JsonChild(kv.second, "run_time_s"), "methods." + kv.first.Scalar() + ".run_time_s"), "%.2f") + "</tr>\n";
     }
   }
   if (rows.empty()) return "<p class=\"note\">No errors: the runs had no reference (--truth).</p>\n";
@@ -141,12 +141,12 @@ std::string ConsistencyTable(const std::vector<RunData>& runs) {
         if (!s) continue;
         const std::string k = "methods." + kv.first.Scalar() + ".errors.consistency." + scope + ".";
         rows += "<tr>" + NameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) + NameCell(scope) +
-                Cell(Num(r, JsonChild(s, "epochs"), k + "epochs"), "%.0f");
+                Cell(SummaryNumber(r, JsonChild(s, "epochs"), k + "epochs"), "%.0f");
         for (const char* key : kKeys) {
-          const double v = Num(r, JsonChild(s, key), k + key);
+          const double v = SummaryNumber(r, JsonChild(s, key), k + key);
           rows += Cell(v, "%.2f", Dishonest(v));
         }
-        rows += Cell(Num(r, JsonChild(s, "pos_nees_mean"), k + "pos_nees_mean"), "%.2f") + "</tr>\n";
+        rows += Cell(SummaryNumber(r, JsonChild(s, "pos_nees_mean"), k + "pos_nees_mean"), "%.2f") + "</tr>\n";
       }
     }
   }
@@ -165,18 +165,18 @@ std::string ResidualsTable(const std::vector<RunData>& runs) {
       for (const auto& g : JsonChild(kv.second, "residuals")) {
         const YAML::Node v = g.second;
         const std::string k = "methods." + m + ".residuals." + g.first.Scalar() + ".";
-        const double dof = Num(r, JsonChild(v, "dof"), k + "dof");
+        const double dof = SummaryNumber(r, JsonChild(v, "dof"), k + "dof");
         const double configured = JsonChild(v, "configured_chi2_per_dof") && !JsonChild(v, "configured_chi2_per_dof").IsNull()
-                                      ? Num(r, JsonChild(v, "configured_chi2_per_dof"), k + "configured_chi2_per_dof")
-                                      : Num(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof");
+                                      ? SummaryNumber(r, JsonChild(v, "configured_chi2_per_dof"), k + "configured_chi2_per_dof")
+                                      : SummaryNumber(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof");
         const bool adapted = JsonChild(v, "adapted") && JsonChild(v, "adapted").Scalar() == "true";
         const YAML::Node count = JsonChild(JsonChild(kv.second, "counts"), g.first.Scalar());
         rows += "<tr>" + NameCell(MethodName(r, m, runs.size() > 1)) + NameCell(g.first.Scalar()) +
-                Cell(Num(r, JsonChild(v, "rows"), k + "rows"), "%.0f") + Cell(dof, "%.1f") +
-                Cell(count ? Num(r, JsonChild(count, "rejected"), "counts.rejected") : std::nan(""), "%.0f") +
+                Cell(SummaryNumber(r, JsonChild(v, "rows"), k + "rows"), "%.0f") + Cell(dof, "%.1f") +
+                Cell(count ? SummaryNumber(r, JsonChild(count, "rejected"), "counts.rejected") : std::nan(""), "%.0f") +
                 Cell(dof >= 1.0 ? configured : std::nan(""), "%.3f", dof >= 10.0 && configured > 3.0) +
-                Cell(adapted ? Num(r, JsonChild(v, "sigma_scale"), k + "sigma_scale") : std::nan(""), "%.3f") +
-                Cell(adapted ? Num(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof") : std::nan(""), "%.3f") + "</tr>\n";
+                Cell(adapted ? SummaryNumber(r, JsonChild(v, "sigma_scale"), k + "sigma_scale") : std::nan(""), "%.3f") +
+                Cell(adapted ? SummaryNumber(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof") : std::nan(""), "%.3f") + "</tr>\n";
       }
     }
   }
@@ -235,11 +235,11 @@ std::string ParameterCell(const RunData& r, const std::string& m, const std::str
   if (!p) return "<td>–</td>";
   const double scale = kind == "imu_scale_factors" ? 1e6 : 1.0;
   const std::string k = "methods." + m + "." + kind + "." + name + ".";
-  const double value = Num(r, JsonChild(p, "value"), k + "value") * scale, std = Num(r, JsonChild(p, "std"), k + "std") * scale;
+  const double value = SummaryNumber(r, JsonChild(p, "value"), k + "value") * scale, std = SummaryNumber(r, JsonChild(p, "std"), k + "std") * scale;
   if (JsonChild(p, "observable") && JsonChild(p, "observable").Scalar() == "false") {
-    return "<td class=\"bad\">not observable (" + Fmt("%.4g", value) + " ± " + Fmt("%.2g", std) + ")</td>";
+    return "<td class=\"bad\">not observable (" + CellText("%.4g", value) + " ± " + CellText("%.2g", std) + ")</td>";
   }
-  return "<td>" + Fmt("%.4g", value) + " ± " + Fmt("%.2g", std) + "</td>";
+  return "<td>" + CellText("%.4g", value) + " ± " + CellText("%.2g", std) + "</td>";
 }
 
 /// Per folder: one row per parameter (auxiliary states, IMU scale factors), one column per method.
