@@ -28,6 +28,7 @@
 #include "core/io/ulog_time.h"
 #include "core/units.h"
 #include "problems/gnss_ins/run.h"
+#include "problems/report/report.h"
 
 DEFINE_string(kfgins_config, "", "KF-GINS YAML configuration, taken unchanged (its imupath, gnsspath, outputpath are used when --imu, --gnss, --out are not given)");
 DEFINE_string(obgins_config, "", "OB_GINS YAML configuration, taken unchanged (its imufile, gnssfile, outputpath are used when --imu, --gnss, --out are not given; with odometer.isuseodo the IMU file's odometer column and the NHC)");
@@ -44,6 +45,7 @@ DEFINE_string(vehicle_lever_arm_b_m, "", "x,y,z of the vehicle reference point (
 DEFINE_double(gate_probability, NAN, "Filter: probability of the chi-square gate on each innovation, in (0, 1] (1: no gate; default: the configuration's filter.gate_probability, 0.9999, or 1 for a KF-GINS configuration)");
 DEFINE_bool(variance_components, true, "smooth: estimate each residual group's noise scale in the batch (variance components); false keeps the configured noise");
 DEFINE_bool(strict, false, "Exit with code 3 when the run reports warnings (rejections over 10 %, resets, chi2/dof over 3, inconsistent sigma); the outputs are written either way");
+DEFINE_bool(report, false, "After a successful run, write OUT/report.html (navtwin report OUT: figures and tables)");
 DEFINE_string(demo_mag, "vector", "smooth --demo: magnetometer use, off|vector|heading|heading_2axis");
 
 namespace navtwin::app {
@@ -234,6 +236,17 @@ void ReportULogTimes(const Options& opt, const Files& files) {
   }
 }
 
+/// --report: OUT/report.html from the folder just written.
+void WriteRunReport(const Options& opt, const std::string& out_dir) {
+  report::ReportOptions options;
+  options.run_dirs = {out_dir};
+  options.out_path = out_dir + "/report.html";
+  options.progress = &std::cerr;
+  const report::ReportSummary summary = report::WriteReport(options);
+  std::cerr << opt.command << ": report " << options.out_path << " (" << summary.figures << " figures, "
+            << summary.run_time_s << " s)\n";
+}
+
 gnss_ins::RunMethods MethodsFromFlags(const Options& opt) {
   if (opt.command == "smooth") return gnss_ins::RunMethods::kAll;
   return FLAGS_smoother == "rts" ? gnss_ins::RunMethods::kFilterRts : gnss_ins::RunMethods::kFilter;
@@ -285,6 +298,7 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
   } else {
     std::cout << gnss_ins::RunTable(run_options, run);
   }
+  if (FLAGS_report) WriteRunReport(opt, files.out);
   return FLAGS_strict && !run.warnings.empty() ? kExitWarnings : kExitOk;
 }
 
@@ -293,14 +307,14 @@ const char* const kNavigateUsage =
     "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--init_from NAV] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
-    "[--gate_probability P] [--strict] [--format=json]";
+    "[--gate_probability P] [--strict] [--report] [--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
     "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--init_from NAV] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
-    "[--gate_probability P] [--variance_components=false] [--strict] [--format=json]\n"
-    "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags]";
+    "[--gate_probability P] [--variance_components=false] [--strict] [--report] [--format=json]\n"
+    "       navtwin smooth --demo --out DIR [--demo_scenario NAME] [--demo_mag MODE] [--seed N] [outage flags] [--report]";
 
 int RunNavigate(const std::vector<std::string>& args) { return Run({"navigate", kNavigateUsage}, args); }
 int RunSmooth(const std::vector<std::string>& args) { return Run({"smooth", kSmoothUsage}, args); }
@@ -314,7 +328,7 @@ Command NavigateCommand() {
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "smoother", "truth",
            "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
            "calibration", "imu_temperature_degC", "init_from", "nhc", "nhc_sigma_mps", "odometer", "vehicle_mounting_rpy_deg",
-           "vehicle_lever_arm_b_m", "gate_probability", "strict"},
+           "vehicle_lever_arm_b_m", "gate_probability", "strict", "report"},
           &RunNavigate};
 }
 
@@ -326,7 +340,7 @@ Command SmoothCommand() {
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
            "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "init_from", "nhc", "nhc_sigma_mps",
            "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m", "gate_probability",
-           "variance_components", "strict"},
+           "variance_components", "strict", "report"},
           &RunSmooth};
 }
 

@@ -32,6 +32,7 @@ Command TransferAlignCommand();
 Command TransferAlignAnsflCommand();
 Command CalibrateImuCommand();
 Command CalibrateMagCommand();
+Command ReportCommand();
 
 /// Exit codes shared by all subcommands.
 constexpr int kExitOk = 0;

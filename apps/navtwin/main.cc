@@ -25,7 +25,8 @@ std::vector<Command> AllCommands() {
           SimulateCommand(),      AllanCommand(),         NavigateCommand(),
           SmoothCommand(),        LevelCommand(),         LevelMcCommand(),
           InflightAlignCommand(), InflightMcCommand(),    TransferAlignCommand(),
-          TransferAlignAnsflCommand(), CalibrateImuCommand(), CalibrateMagCommand()};
+          TransferAlignAnsflCommand(), CalibrateImuCommand(), CalibrateMagCommand(),
+          ReportCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {
