@@ -50,6 +50,8 @@ struct RunSinks {
   NavOutputWriter* writer;
   MethodFiles* method_files;  ///< committed by RunGnssIns when the whole run succeeds
 
+  /// The folder <out_dir>/<method>/ (nav.csv, std.csv) and, with a reference, the scorer
+  /// writing its errors.csv.
   MethodSinks Open(const std::string& method) const {
     method_files->push_back(
         std::make_unique<MethodOutputWriter>(options.out_dir, method, config.filter.scale_factors));
