@@ -50,4 +50,10 @@ void AtomicFile::Commit() {
   committed_ = true;
 }
 
+void AtomicFile::Revoke() {
+  if (!committed_) return;
+  std::remove(path_.c_str());
+  committed_ = false;
+}
+
 }  // namespace navtwin

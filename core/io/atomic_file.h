@@ -1,6 +1,7 @@
 // Output files appear whole or not at all: data goes to a temporary file in the same
 // folder, renamed over the target by Commit(). A writer destroyed without Commit()
-// (an exception, bad input) removes the temporary, so no partial output is left.
+// (an exception, bad input) removes the temporary, so no partial output is left; a
+// committed file that belongs to a larger output which then fails is removed by Revoke().
 // Doubles written to stream() come out in the shortest form that reads back exactly.
 #pragma once
 
@@ -21,6 +22,9 @@ class AtomicFile {
   const std::string& path() const { return path_; }
   /// Flushes, closes and renames onto the target; throws std::runtime_error on failure.
   void Commit();
+  /// Undoes a Commit (a later step of an all-or-nothing output failed): removes the file.
+  /// Before Commit it does nothing (the destructor removes the temporary).
+  void Revoke();
 
  private:
   std::string path_;

@@ -66,6 +66,7 @@ class KfginsNavWriter {
   explicit KfginsNavWriter(const std::string& path);
   void Write(const NavState& state);
   void Commit();
+  void Revoke() { file_.Revoke(); }  ///< AtomicFile::Revoke
 
  private:
   AtomicFile file_;

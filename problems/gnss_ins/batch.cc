@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include <ceres/cost_function.h>
 #include <ceres/loss_function.h>
 #include <ceres/problem.h>
 
@@ -230,7 +231,9 @@ class BatchSmoother : public ins::BatchAccess {
   double* aux(int i) override { return &aux_[static_cast<std::size_t>(aux_begin_[current_] + i)]; }
   void Add(ceres::CostFunction* cost, bool robust, const std::vector<double*>& blocks,
            const std::string& key) override {
-    problem_->AddResidualBlock(groups_.Wrap(cost, SourceRowGroups(key)), robust ? huber_.get() : nullptr, blocks);
+    const ceres::ResidualBlockId id =
+        problem_->AddResidualBlock(groups_.Wrap(cost, SourceRowGroups(key)), robust ? huber_.get() : nullptr, blocks);
+    measurement_blocks_.push_back({id, key, StateTime(blocks)});
     ++counts_[key].used;
   }
   void Count(const std::string& key, bool used) override {
@@ -253,6 +256,8 @@ class BatchSmoother : public ins::BatchAccess {
   void EstimateVarianceComponents(const BatchOptions& options, std::ostringstream* report);
   void Covariance(Solution* solution, std::ostringstream* report);
   std::vector<int> SourceRowGroups(const std::string& key);
+  double StateTime(const std::vector<double*>& blocks) const;
+  std::vector<MeasurementResidual> MeasurementResiduals() const;
   ceres::CostFunction* Group(ceres::CostFunction* cost, const char* group, bool estimable = true) {
     return groups_.Wrap(cost, {groups_.Group(group, estimable)});
   }
@@ -281,6 +286,14 @@ class BatchSmoother : public ins::BatchAccess {
   std::vector<std::shared_ptr<ImuPreintegration>> pre_;  ///< interval i: states i -> i + 1
   std::vector<ceres::ResidualBlockId> imu_factors_;
   std::map<std::string, MeasurementCount> counts_;
+  /// A source's residual block (BatchAccess::Add): its count key and the time of its state.
+  struct MeasurementBlock {
+    ceres::ResidualBlockId id;
+    std::string key;
+    double t_s;
+  };
+  std::vector<MeasurementBlock> measurement_blocks_;
+  std::map<const double*, double> state_time_;  ///< a state's position, velocity, attitude block -> its time
   std::size_t imu_samples_ = 0;
   ResidualGroups groups_;
   std::map<std::string, std::vector<int>> source_groups_;  ///< "source index/key" -> row groups
@@ -359,7 +372,39 @@ void BatchSmoother::MakeViews() {
     v.motion = s.motion;
     v.still = s.still;
     v.anchor = s.anchor;
+    for (const double* block : {v.pos, v.vel, v.q}) state_time_[block] = s.t_s;
   }
+}
+
+/// The time of the first state whose block is among `blocks` (NaN: none, only auxiliary
+/// parameters).
+double BatchSmoother::StateTime(const std::vector<double*>& blocks) const {
+  for (const double* block : blocks) {
+    const auto it = state_time_.find(block);
+    if (it != state_time_.end()) return it->second;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+/// Per source residual block, in time order (the sources' order within a time): the squared
+/// norm of its whitened residual at the current values, with the groups' current variance
+/// factors and without the robust loss.
+std::vector<MeasurementResidual> BatchSmoother::MeasurementResiduals() const {
+  std::vector<MeasurementResidual> rows;
+  rows.reserve(measurement_blocks_.size());
+  Eigen::VectorXd r;
+  for (const MeasurementBlock& m : measurement_blocks_) {
+    const int dof = problem_->GetCostFunctionForResidualBlock(m.id)->num_residuals();
+    r.resize(dof);
+    double cost = 0.0;
+    const bool ok = problem_->EvaluateResidualBlock(m.id, false, &cost, r.data(), nullptr);
+    rows.push_back({m.t_s, m.key, dof, ok ? r.squaredNorm() : std::numeric_limits<double>::quiet_NaN(), false});
+  }
+  // NaN times (no state block) last.
+  std::stable_sort(rows.begin(), rows.end(), [](const MeasurementResidual& a, const MeasurementResidual& b) {
+    return !std::isnan(a.t_s) && (std::isnan(b.t_s) || a.t_s < b.t_s);
+  });
+  return rows;
 }
 
 /// One pass over the IMU record: the strapdown mechanization from the latest knot of the
@@ -770,6 +815,7 @@ Solution BatchSmoother::Run() {
   if (cfg_.batch.covariance) Covariance(&solution, &report);
   solution.counts = counts_;
   solution.residuals = ResidualSummary(configured_stats_, final_stats_);
+  solution.measurement_residuals = MeasurementResiduals();
   solution.aux_states = aux_states_;
   solution.solver_report = report.str();
   if (!solution.solver_report.empty() && solution.solver_report.back() == '\n') solution.solver_report.pop_back();

@@ -55,7 +55,8 @@ constexpr int kMaxReintegrationRounds = 3;
 /// filter's or RTS knots, increasing in time; the initial values are mechanized from the
 /// latest knot at or before each state with that knot's IMU-error estimates). Method
 /// "batch": epochs = the states with their 15 standard deviations (ins_state.h layout;
-/// empty when config.batch.covariance is false), counts per measurement kind, run time
+/// empty when config.batch.covariance is false), counts per measurement kind, per source
+/// residual block its chi-square at the solution (measurement_residuals), run time
 /// (setup, solve and covariance), solver_report = Ceres' brief report of every solve plus
 /// the reintegration and covariance notes. Progress lines on `progress` when not null.
 /// Throws std::invalid_argument for an empty or unordered start, a start outside the IMU

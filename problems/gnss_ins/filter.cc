@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -77,12 +78,18 @@ class NavigationFilter : public ins::FilterAccess {
   void Count(const std::string& key, bool used) override {
     MeasurementCount& c = counts_[key];
     ++(used ? c.used : c.rejected);
+    Record(key, 0, std::numeric_limits<double>::quiet_NaN(), !used);
   }
   void ResetPositionVelocity(const Eigen::Vector3d& dp_ned_m, const Eigen::Vector3d& dv_n_mps,
                              const Eigen::Vector3d& pos_var, const Eigen::Vector3d& vel_var,
                              const std::string& key) override;
 
  private:
+  /// A row of the filter's measurement residuals at the current epoch (solution.h).
+  void Record(const std::string& key, int dof, double nis, bool rejected) {
+    measurement_residuals_.push_back({epoch_t_s_, key, dof, nis, rejected});
+  }
+
   /// Count keys, auxiliary states and the sample cursors of the sources.
   void RegisterSources() {
     std::vector<double> aux_values;
@@ -299,6 +306,7 @@ class NavigationFilter : public ins::FilterAccess {
   std::vector<RtsKnot> knots_;
   std::map<std::string, MeasurementCount> counts_;
   std::map<std::string, InnovationStats> innovations_;
+  std::vector<MeasurementResidual> measurement_residuals_;
 
   // Measurement models' scratch.
   PositionManifold position_manifold_;
@@ -362,6 +370,7 @@ bool NavigationFilter::Update(std::unique_ptr<ceres::CostFunction> cost, const s
   ++stats.updates;
   stats.nis_capped += std::min(u.nis, u.gate);
   stats.log_det_s += u.log_det_s;
+  Record(key, m, u.nis, !u.accepted);
   if (!u.accepted) {
     ++count.rejected;
     ++stats.rejected;
@@ -390,6 +399,7 @@ void NavigationFilter::ResetPositionVelocity(const Eigen::Vector3d& dp_ned_m, co
   strapdown_.SetState(corrected.nav);
   epoch_dx_ += dx;
   ++counts_[key].used;
+  Record(key, 0, std::numeric_limits<double>::quiet_NaN(), false);
 }
 
 std::size_t NavigationFilter::FirstImuSample() const {
@@ -475,6 +485,7 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
   result.filter.epochs = std::move(epochs_);
   result.filter.counts = counts_;
   result.filter.aux_states = aux_states_;
+  result.filter.measurement_residuals = std::move(measurement_residuals_);
   result.filter.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (run_rts_) {
     const RtsResult smoothed = RunRts(knots_);

@@ -282,6 +282,7 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
       while (k < in.outages.size() && g.t_s >= in.outages[k].second) ++k;
       if (k < in.outages.size() && g.t_s >= in.outages[k].first) {
         ++in.gnss_removed_by_outages;
+        in.gnss_removed.push_back(g);
       } else {
         kept.push_back(g);
       }

@@ -38,6 +38,8 @@ struct Inputs {
   std::vector<OdometerSample> odometer;
   std::size_t bridged_imu_gaps = 0;
   std::size_t gnss_removed_by_outages = 0;
+  /// The GNSS epochs the injected outages removed (gnss_removed_by_outages of them), increasing.
+  std::vector<GnssSample> gnss_removed;
   /// The injected outage intervals [start, end) in time (empty without outages).
   std::vector<std::pair<double, double>> outages;
 };

@@ -1,6 +1,7 @@
 #include "problems/gnss_ins/output.h"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,60 @@ void NumberOrNan(TextLine& line, double x) {
   }
 }
 
+void WriteNavCsvHeader(std::ostream& out) {
+  out << "t_s,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg\n";
+}
+
+void WriteStdCsvHeader(std::ostream& out, bool scale_factors) {
+  out << "t_s,pos_n_std_m,pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,"
+         "vel_d_std_mps,att_n_std_deg,att_e_std_deg,att_d_std_deg,bg_x_std_deg_h,"
+         "bg_y_std_deg_h,bg_z_std_deg_h,ba_x_std_mg,ba_y_std_mg,ba_z_std_mg";
+  if (scale_factors) out << ",sg_x_std_ppm,sg_y_std_ppm,sg_z_std_ppm,sa_x_std_ppm,sa_y_std_ppm,sa_z_std_ppm";
+  out << '\n';
+}
+
+void WriteNavCsvRow(std::ostream& out, const NavState& s) {
+  const Eigen::Vector3d rpy_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
+  const double nav[9] = {s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m,
+                         s.v_n_mps.x(),         s.v_n_mps.y(),         s.v_n_mps.z(),
+                         rpy_deg.x(),           rpy_deg.y(),           rpy_deg.z()};
+  Row(out, s.t_s, nav, 9);
+}
+
+/// Standard deviations in the units of the header; NaN where not computed.
+void WriteStdCsvRow(std::ostream& out, const NavEpoch& epoch, bool scale_factors) {
+  const int n = scale_factors ? err::kSize21 : err::kSize15;
+  double sd[err::kSize21];
+  for (int i = 0; i < n; ++i) {
+    double scale = 1.0;
+    if (i >= err::kAtt && i < err::kBg) scale = kRadToDeg;
+    if (i >= err::kBg && i < err::kBa) scale = 1.0 / kDegPerHour_radps;
+    if (i >= err::kBa && i < err::kSg) scale = 1.0 / kMilliG_mps2;
+    if (i >= err::kSg) scale = 1.0 / kPpm;
+    sd[i] = i < epoch.std.size() ? epoch.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
+  }
+  Row(out, epoch.state.nav.t_s, sd, n);
+}
+
+/// A folder for a method's files: created when missing (returns whether it was).
+bool MakeMethodFolder(const std::string& dir) {
+  struct stat st;
+  if (::stat(dir.c_str(), &st) != 0) {
+    if (::mkdir(dir.c_str(), 0755) != 0) throw std::runtime_error("cannot create the folder " + dir);
+    return true;
+  }
+  if (!S_ISDIR(st.st_mode)) throw std::runtime_error(dir + " exists and is not a folder");
+  return false;
+}
+
+void WriteGnssCsvRow(std::ostream& out, const GnssSample& g, bool in_outage) {
+  TextLine line;
+  line.Number(g.t_s).Char(',').Number(g.lat_rad * kRadToDeg).Char(',').Number(g.lon_rad * kRadToDeg);
+  line.Char(',').Number(g.h_m);
+  for (int i = 0; i < 3; ++i) NumberOrNan(line.Char(','), g.pos_std_ned_m[i]);
+  line.Char(',').Char(in_outage ? '1' : '0').Char('\n').WriteTo(out);
+}
+
 }  // namespace
 
 const char* const NavOutputWriter::kFiles[4] = {"nav.nav", "nav.csv", "std.csv", "imu_errors.csv"};
@@ -42,14 +97,8 @@ NavOutputWriter::NavOutputWriter(const std::string& dir, bool scale_factors)
       csv_(dir + "/" + kFiles[1]),
       std_(dir + "/" + kFiles[2]),
       errors_(dir + "/" + kFiles[3]) {
-  csv_.stream() << "t_s,lat_deg,lon_deg,h_m,vn_mps,ve_mps,vd_mps,roll_deg,pitch_deg,yaw_deg\n";
-  std_.stream() << "t_s,pos_n_std_m,pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,"
-                   "vel_d_std_mps,att_n_std_deg,att_e_std_deg,att_d_std_deg,bg_x_std_deg_h,"
-                   "bg_y_std_deg_h,bg_z_std_deg_h,ba_x_std_mg,ba_y_std_mg,ba_z_std_mg";
-  if (scale_factors_) {
-    std_.stream() << ",sg_x_std_ppm,sg_y_std_ppm,sg_z_std_ppm,sa_x_std_ppm,sa_y_std_ppm,sa_z_std_ppm";
-  }
-  std_.stream() << '\n';
+  WriteNavCsvHeader(csv_.stream());
+  WriteStdCsvHeader(std_.stream(), scale_factors_);
   errors_.stream() << "t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg";
   if (scale_factors_) errors_.stream() << ",sg_x_ppm,sg_y_ppm,sg_z_ppm,sa_x_ppm,sa_y_ppm,sa_z_ppm";
   errors_.stream() << '\n';
@@ -58,24 +107,8 @@ NavOutputWriter::NavOutputWriter(const std::string& dir, bool scale_factors)
 void NavOutputWriter::Write(const NavEpoch& epoch) {
   const NavState& s = epoch.state.nav;
   nav_.Write(s);  // checks the state is finite (std::invalid_argument otherwise)
-  const Eigen::Vector3d rpy_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
-  const double nav[9] = {s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m,
-                         s.v_n_mps.x(),         s.v_n_mps.y(),         s.v_n_mps.z(),
-                         rpy_deg.x(),           rpy_deg.y(),           rpy_deg.z()};
-  Row(csv_.stream(), s.t_s, nav, 9);
-
-  // Standard deviations in the units of the header; NaN where not computed.
-  const int n = scale_factors_ ? err::kSize21 : err::kSize15;
-  double sd[err::kSize21];
-  for (int i = 0; i < n; ++i) {
-    double scale = 1.0;
-    if (i >= err::kAtt && i < err::kBg) scale = kRadToDeg;
-    if (i >= err::kBg && i < err::kBa) scale = 1.0 / kDegPerHour_radps;
-    if (i >= err::kBa && i < err::kSg) scale = 1.0 / kMilliG_mps2;
-    if (i >= err::kSg) scale = 1.0 / kPpm;
-    sd[i] = i < epoch.std.size() ? epoch.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
-  }
-  Row(std_.stream(), s.t_s, sd, n);
+  WriteNavCsvRow(csv_.stream(), s);
+  WriteStdCsvRow(std_.stream(), epoch, scale_factors_);
 
   const ImuErrors& e = epoch.state.imu;
   double imu[12];
@@ -96,22 +129,54 @@ void NavOutputWriter::Commit() {
   errors_.Commit();
 }
 
-ErrorsCsvWriter::ErrorsCsvWriter(const std::string& out_dir, const std::string& method, bool reference_std)
-    : dir_(out_dir + "/" + method), path_(dir_ + "/errors.csv"), reference_std_(reference_std) {
-  struct stat st;
-  if (::stat(dir_.c_str(), &st) != 0) {
-    if (::mkdir(dir_.c_str(), 0755) != 0) throw std::runtime_error("cannot create the folder " + dir_);
-    created_dir_ = true;
-  } else if (!S_ISDIR(st.st_mode)) {
-    throw std::runtime_error(dir_ + " exists and is not a folder");
-  }
+void NavOutputWriter::Revoke() {
+  nav_.Revoke();
+  csv_.Revoke();
+  std_.Revoke();
+  errors_.Revoke();
+}
+
+MethodOutputWriter::MethodOutputWriter(const std::string& out_dir, const std::string& method, bool scale_factors)
+    : dir_(out_dir + "/" + method), scale_factors_(scale_factors) {
+  created_dir_ = MakeMethodFolder(dir_);
   try {
-    file_ = std::make_unique<AtomicFile>(path_);
+    nav_csv_ = std::make_unique<AtomicFile>(dir_ + "/nav.csv");
+    std_csv_ = std::make_unique<AtomicFile>(dir_ + "/std.csv");
   } catch (...) {
+    nav_csv_.reset();
     if (created_dir_) ::rmdir(dir_.c_str());
     throw;
   }
-  std::ostream& out = file_->stream();
+  WriteNavCsvHeader(nav_csv_->stream());
+  WriteStdCsvHeader(std_csv_->stream(), scale_factors_);
+}
+
+MethodOutputWriter::~MethodOutputWriter() {
+  nav_csv_.reset();  // each removes its temporary unless committed
+  std_csv_.reset();
+  errors_csv_.reset();
+  residuals_csv_.reset();
+  if (created_dir_ && !committed_) ::rmdir(dir_.c_str());
+}
+
+std::vector<AtomicFile*> MethodOutputWriter::Files() const {
+  std::vector<AtomicFile*> files;
+  for (const auto* f : {&nav_csv_, &std_csv_, &errors_csv_, &residuals_csv_}) {
+    if (*f) files.push_back(f->get());
+  }
+  return files;
+}
+
+void MethodOutputWriter::Write(const NavEpoch& epoch) {
+  WriteNavCsvRow(nav_csv_->stream(), epoch.state.nav);
+  WriteStdCsvRow(std_csv_->stream(), epoch, scale_factors_);
+  ++count_;
+}
+
+void MethodOutputWriter::OpenErrors(bool reference_std) {
+  reference_std_ = reference_std;
+  errors_csv_ = std::make_unique<AtomicFile>(errors_path());
+  std::ostream& out = errors_csv_->stream();
   out << "t_s,pos_n_err_m,pos_e_err_m,pos_d_err_m,vel_n_err_mps,vel_e_err_mps,vel_d_err_mps,roll_err_deg,"
          "pitch_err_deg,yaw_err_deg,pos_n_std_m,pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,"
          "vel_d_std_mps,roll_std_deg,pitch_std_deg,yaw_std_deg,in_outage";
@@ -121,12 +186,7 @@ ErrorsCsvWriter::ErrorsCsvWriter(const std::string& out_dir, const std::string& 
   out << '\n';
 }
 
-ErrorsCsvWriter::~ErrorsCsvWriter() {
-  file_.reset();  // removes the temporary unless committed
-  if (created_dir_ && !committed_) ::rmdir(dir_.c_str());
-}
-
-void ErrorsCsvWriter::Write(const ScoredEpoch& e) {
+void MethodOutputWriter::WriteErrors(const ScoredEpoch& e) {
   TextLine line;
   line.Number(e.t_s);
   for (int c = 0; c < kScoredComponents; ++c) NumberOrNan(line.Char(','), c >= 6 ? e.err[c] * kRadToDeg : e.err[c]);
@@ -135,21 +195,44 @@ void ErrorsCsvWriter::Write(const ScoredEpoch& e) {
   }
   line.Char(',').Char(e.in_outage ? '1' : '0');
   for (int c = 0; c < 6 && reference_std_; ++c) NumberOrNan(line.Char(','), e.ref_std[c]);
-  line.Char('\n').WriteTo(file_->stream());
-  ++count_;
+  line.Char('\n').WriteTo(errors_csv_->stream());
 }
 
-void ErrorsCsvWriter::Commit() {
-  file_->Commit();
+void MethodOutputWriter::WriteResiduals(const std::vector<MeasurementResidual>& rows) {
+  if (residuals_csv_) throw std::logic_error("MethodOutputWriter: residuals.csv written twice");
+  residuals_csv_ = std::make_unique<AtomicFile>(dir_ + "/residuals.csv");
+  std::ostream& out = residuals_csv_->stream();
+  out << "t_s,sensor,dof,chi2,rejected\n";
+  for (const MeasurementResidual& r : rows) {
+    TextLine line;
+    NumberOrNan(line, r.t_s);
+    line.Char(',');
+    for (const char c : r.sensor) line.Char(c);
+    line.Char(',').Integer(r.dof).Char(',');
+    NumberOrNan(line, r.chi2);
+    line.Char(',').Char(r.rejected ? '1' : '0').Char('\n').WriteTo(out);
+  }
+}
+
+void MethodOutputWriter::Commit() {
+  for (AtomicFile* f : Files()) f->Commit();
   committed_ = true;
 }
 
-void ErrorsCsvWriter::Revoke() {
-  if (!committed_) return;
-  std::remove(path_.c_str());
-  if (created_dir_) ::rmdir(dir_.c_str());
+void MethodOutputWriter::Revoke() {
+  for (AtomicFile* f : Files()) f->Revoke();
   committed_ = false;
-  created_dir_ = false;
+  // Empty unless a file's temporary is still there; the destructor tries again after them.
+  if (created_dir_) ::rmdir(dir_.c_str());
+}
+
+void WriteGnssCsv(std::ostream& out, const std::vector<GnssSample>& used, const std::vector<GnssSample>& removed) {
+  out << "t_s,lat_deg,lon_deg,h_m,pos_n_std_m,pos_e_std_m,pos_d_std_m,in_outage\n";
+  std::size_t u = 0, r = 0;
+  while (u < used.size() || r < removed.size()) {
+    const bool take_removed = u == used.size() || (r < removed.size() && removed[r].t_s < used[u].t_s);
+    WriteGnssCsvRow(out, take_removed ? removed[r++] : used[u++], take_removed);
+  }
 }
 
 void WriteJsonFile(const std::string& path, const std::function<void(JsonWriter&)>& body) {

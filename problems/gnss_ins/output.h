@@ -12,8 +12,14 @@
 //   imu_errors.csv  t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg
 //                   [,sg_x_ppm,sg_y_ppm,sg_z_ppm,sa_x_ppm,sa_y_ppm,sa_z_ppm]
 // The bracketed scale-factor columns appear when the writer is built with scale_factors.
-// With a reference (scoring.h), per scored method (filter, rts, batch) in the folder
-// <method>/ (ErrorsCsvWriter), one row per compared reference epoch:
+// Per method the run computed (filter, rts, batch, filter_adapted, rts_adapted), in the
+// folder <method>/ (MethodOutputWriter):
+//   nav.csv, std.csv  the columns above, at the same output epochs
+//   residuals.csv     t_s,sensor,dof,chi2,rejected: one row per measurement of an estimator
+//                     with residuals of its own (filter, batch; MeasurementResidual in
+//                     solution.h); chi2 and dof "nan" / 0 for a sample counted without an
+//                     update
+// and with a reference (scoring.h), one row per compared reference epoch:
 //   errors.csv      t_s,pos_n_err_m,pos_e_err_m,pos_d_err_m,vel_n_err_mps,vel_e_err_mps,
 //                   vel_d_err_mps,roll_err_deg,pitch_err_deg,yaw_err_deg,pos_n_std_m,
 //                   pos_e_std_m,pos_d_std_m,vel_n_std_mps,vel_e_std_mps,vel_d_std_mps,
@@ -24,19 +30,26 @@
 //                   those errors, ScoredEpoch in scoring.h; in_outage 1 inside an injected
 //                   outage, else 0; the bracketed reference sigmas for a GNSS reference;
 //                   "nan" for components the reference lacks or sigmas not computed)
+// The GNSS fixes the run read (WriteGnssCsv), antenna positions as given:
+//   gnss.csv        t_s,lat_deg,lon_deg,h_m,pos_n_std_m,pos_e_std_m,pos_d_std_m,in_outage
+// The whole folder is described in docs/run-folder.md.
 // Every file appears whole or not at all (core/io/atomic_file.h): nothing is left in the
 // folder unless Commit() is called.
 #pragma once
 
 #include <functional>
 #include <memory>
+#include <ostream>
 #include <string>
+#include <vector>
 
 #include "core/io/atomic_file.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
+#include "core/types.h"
 #include "problems/gnss_ins/ins_vocabulary.h"
 #include "problems/gnss_ins/scoring.h"
+#include "problems/gnss_ins/solution.h"
 
 namespace navtwin::gnss_ins {
 
@@ -48,6 +61,8 @@ class NavOutputWriter {
   void Write(const NavEpoch& epoch);
   /// Renames the four files into place.
   void Commit();
+  /// Undoes a Commit (a later step of the run failed): removes the four files.
+  void Revoke();
   std::size_t count() const { return count_; }
 
   /// The file names written into the folder.
@@ -62,35 +77,50 @@ class NavOutputWriter {
   AtomicFile errors_;
 };
 
-/// <out_dir>/<method>/errors.csv (layout above). The folder is created when missing and,
-/// like the file, removed again unless Commit() succeeds (a failed run leaves nothing).
-class ErrorsCsvWriter {
+/// The folder <out_dir>/<method>/ (layout above). The folder is created when missing and,
+/// like its files, removed again unless Commit() succeeds (a failed run leaves nothing).
+class MethodOutputWriter {
  public:
-  /// reference_std: add the reference-sigma columns (a GNSS reference). Throws
-  /// std::runtime_error when the folder or the file cannot be made.
-  ErrorsCsvWriter(const std::string& out_dir, const std::string& method, bool reference_std);
-  ~ErrorsCsvWriter();
-  ErrorsCsvWriter(const ErrorsCsvWriter&) = delete;
-  ErrorsCsvWriter& operator=(const ErrorsCsvWriter&) = delete;
+  /// Opens nav.csv and std.csv (with the scale-factor columns when scale_factors). Throws
+  /// std::runtime_error when the folder or a file cannot be made.
+  MethodOutputWriter(const std::string& out_dir, const std::string& method, bool scale_factors);
+  ~MethodOutputWriter();
+  MethodOutputWriter(const MethodOutputWriter&) = delete;
+  MethodOutputWriter& operator=(const MethodOutputWriter&) = delete;
 
-  void Write(const ScoredEpoch& e);
-  /// Renames the file into place.
+  /// Appends one output epoch (in time order) to nav.csv and std.csv.
+  void Write(const NavEpoch& epoch);
+  /// Opens errors.csv; reference_std: with the reference-sigma columns (a GNSS reference).
+  void OpenErrors(bool reference_std);
+  /// Appends a compared epoch to errors.csv (OpenErrors first).
+  void WriteErrors(const ScoredEpoch& e);
+  /// Writes residuals.csv with `rows` (whole; at most once).
+  void WriteResiduals(const std::vector<MeasurementResidual>& rows);
+  /// Renames the files into place.
   void Commit();
-  /// Undoes a Commit (a later step of the run failed): removes the file, and the folder
+  /// Undoes a Commit (a later step of the run failed): removes the files, and the folder
   /// when this writer created it.
   void Revoke();
   std::size_t count() const { return count_; }
-  const std::string& path() const { return path_; }
+  /// <out_dir>/<method>/errors.csv
+  std::string errors_path() const { return dir_ + "/errors.csv"; }
 
  private:
   std::string dir_;
-  std::string path_;
-  bool reference_std_;
+  bool scale_factors_;
+  bool reference_std_ = false;
   bool created_dir_ = false;
   bool committed_ = false;
   std::size_t count_ = 0;
-  std::unique_ptr<AtomicFile> file_;
+  std::unique_ptr<AtomicFile> nav_csv_, std_csv_;
+  std::unique_ptr<AtomicFile> errors_csv_, residuals_csv_;  ///< null until opened
+  /// The files opened, in the order above.
+  std::vector<AtomicFile*> Files() const;
 };
+
+/// gnss.csv (layout above) into `out`: the fixes the estimators used and those the injected
+/// outages removed (in_outage 1), merged in time order; sigmas "nan" where the file has none.
+void WriteGnssCsv(std::ostream& out, const std::vector<GnssSample>& used, const std::vector<GnssSample>& removed);
 
 /// Writes `path` atomically with one JSON document produced by `body`.
 void WriteJsonFile(const std::string& path, const std::function<void(JsonWriter&)>& body);

@@ -32,53 +32,69 @@ namespace navtwin::gnss_ins {
 namespace {
 
 using Scorer = std::unique_ptr<TrajectoryScorer>;
-using ErrorFiles = std::vector<std::unique_ptr<ErrorsCsvWriter>>;
+using MethodFiles = std::vector<std::unique_ptr<MethodOutputWriter>>;
 
-/// Where the estimators' outputs go: the solution writer (output epochs) and, with a
-/// reference, a scorer per method (every IMU epoch) writing the method's errors.csv.
+/// Where one method's outputs go: its folder <out_dir>/<method>/ (output epochs, residuals)
+/// and, with a reference, a scorer (every IMU epoch) writing the folder's errors.csv.
+struct MethodSinks {
+  Scorer scorer;  ///< null without a reference
+  MethodOutputWriter* files;
+};
+
+/// Where the estimators' outputs go: the solution writer (output epochs) and each method's
+/// folder.
 struct RunSinks {
   const RunOptions& options;
   const GnssInsConfig& config;
   const Inputs& inputs;
   NavOutputWriter* writer;
-  ErrorFiles* error_files;  ///< committed by RunGnssIns when the whole run succeeds
+  MethodFiles* method_files;  ///< committed by RunGnssIns when the whole run succeeds
 
-  /// A scorer for `method` whose compared epochs go to <out_dir>/<method>/errors.csv;
-  /// null without a reference.
-  Scorer OpenScorer(const std::string& method) const {
-    if (options.truth.empty()) return nullptr;
-    Scorer scorer = OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
-    error_files->push_back(std::make_unique<ErrorsCsvWriter>(options.out_dir, method, scorer->reference_has_std()));
-    ErrorsCsvWriter* csv = error_files->back().get();
-    scorer->OnEpoch([csv](const ScoredEpoch& e) { csv->Write(e); });
-    return scorer;
+  /// The folder <out_dir>/<method>/ (nav.csv, std.csv) and, with a reference, the scorer
+  /// writing its errors.csv.
+  MethodSinks Open(const std::string& method) const {
+    method_files->push_back(
+        std::make_unique<MethodOutputWriter>(options.out_dir, method, config.filter.scale_factors));
+    MethodSinks sinks{nullptr, method_files->back().get()};
+    if (options.truth.empty()) return sinks;
+    sinks.scorer = OpenReference(options.truth, inputs.outages, config.installation.antenna_lever_arm_b_m);
+    sinks.files->OpenErrors(sinks.scorer->reference_has_std());
+    sinks.scorer->OnEpoch([files = sinks.files](const ScoredEpoch& e) { files->WriteErrors(e); });
+    return sinks;
   }
 };
 
-/// The callback an estimator's states at every IMU epoch go to: all of them to `scorer`
-/// (when not null), so the score does not depend on the output rate, and the output
-/// epochs (OutputDecimator at config.output_rate_hz) to `writer` (when not null).
-std::function<void(const NavEpoch&)> Feed(TrajectoryScorer* scorer, NavOutputWriter* writer, double output_rate_hz) {
-  return [scorer, writer, decimator = OutputDecimator(output_rate_hz)](const NavEpoch& e) mutable {
+/// The callback an estimator's states at every IMU epoch go to: all of them to the
+/// method's scorer (when there is one), so the score does not depend on the output rate,
+/// and the output epochs (OutputDecimator at config.output_rate_hz) to the method's folder
+/// and to `writer` (when not null: the method written at the top level).
+std::function<void(const NavEpoch&)> Feed(const MethodSinks& sinks, NavOutputWriter* writer, double output_rate_hz) {
+  return [scorer = sinks.scorer.get(), files = sinks.files, writer,
+          decimator = OutputDecimator(output_rate_hz)](const NavEpoch& e) mutable {
     if (scorer) scorer->Add(e);
-    if (writer && decimator.Take(e.state.nav.t_s)) writer->Write(e);
+    if (!decimator.Take(e.state.nav.t_s)) return;
+    files->Write(e);
+    if (writer) writer->Write(e);
   };
 }
 
-MethodRun Scored(const std::string& name, Solution solution, const Scorer& scorer, const RunOptions& options) {
+/// The method's run; residuals.csv in its folder for an estimator with residuals of its own.
+MethodRun Scored(const std::string& name, Solution solution, const MethodSinks& sinks, bool has_residuals) {
+  if (has_residuals) sinks.files->WriteResiduals(solution.measurement_residuals);
   MethodRun m{name, std::move(solution), std::nullopt, ""};
-  if (scorer) {
-    m.errors = scorer->Report();
-    m.errors_csv = options.out_dir + "/" + name + "/errors.csv";
+  if (sinks.scorer) {
+    m.errors = sinks.scorer->Report();
+    m.errors_csv = sinks.files->errors_path();
   }
   return m;
 }
 
 /// A smoother's knots densified to every IMU epoch, scored, and written when `writer`.
-MethodRun DensifyAndScore(const std::string& name, Solution knots, const RunSinks& sinks, NavOutputWriter* writer) {
-  const Scorer scorer = sinks.OpenScorer(name);
-  Densify(knots, sinks.inputs, Feed(scorer.get(), writer, sinks.config.output_rate_hz));
-  return Scored(name, std::move(knots), scorer, sinks.options);
+MethodRun DensifyAndScore(const std::string& name, Solution knots, const RunSinks& run_sinks, NavOutputWriter* writer,
+                          bool has_residuals) {
+  const MethodSinks sinks = run_sinks.Open(name);
+  Densify(knots, run_sinks.inputs, Feed(sinks, writer, run_sinks.config.output_rate_hz));
+  return Scored(name, std::move(knots), sinks, has_residuals);
 }
 
 /// With the batch's variance components: the filter and its RTS smoother again with the
@@ -91,12 +107,12 @@ void RunAdaptedFilter(const RunSinks& sinks, const FilterStart& start, GnssInsRu
   if (options.progress) {
     *options.progress << options.command << ": filter + RTS smoother again with the batch's adapted noise\n";
   }
-  const Scorer filter_scorer = sinks.OpenScorer("filter_adapted");
+  const MethodSinks filter_sinks = sinks.Open("filter_adapted");
   FilterResult fr = RunFilter(sinks.inputs, adapted.config, start, true,
-                              Feed(filter_scorer.get(), nullptr, adapted.config.output_rate_hz), options.progress);
-  run->methods.push_back(Scored("filter_adapted", std::move(fr.filter), filter_scorer, options));
+                              Feed(filter_sinks, nullptr, adapted.config.output_rate_hz), options.progress);
+  run->methods.push_back(Scored("filter_adapted", std::move(fr.filter), filter_sinks, true));
   if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
-  run->methods.push_back(DensifyAndScore("rts_adapted", std::move(*fr.rts), sinks, nullptr));
+  run->methods.push_back(DensifyAndScore("rts_adapted", std::move(*fr.rts), sinks, nullptr, false));
 }
 
 /// Filter, then RTS and batch as options.methods asks; the last one goes to the writer.
@@ -109,22 +125,22 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
   if (options.progress) *options.progress << options.command << ": filter" << (run_rts ? " + RTS smoother" : "") << "\n";
   // The alignment runs once, before the filter; the batch's prior is the same start.
   const FilterStart start = InitialFilterState(inputs, config, options.progress);
-  const Scorer filter_scorer = sinks.OpenScorer("filter");
-  FilterResult fr =
-      RunFilter(inputs, config, start, run_rts,
-                Feed(filter_scorer.get(), run_rts ? nullptr : sinks.writer, config.output_rate_hz), options.progress);
-  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_scorer, options));
+  const MethodSinks filter_sinks = sinks.Open("filter");
+  FilterResult fr = RunFilter(inputs, config, start, run_rts,
+                              Feed(filter_sinks, run_rts ? nullptr : sinks.writer, config.output_rate_hz),
+                              options.progress);
+  run->methods.push_back(Scored("filter", std::move(fr.filter), filter_sinks, true));
   run->output_method = "filter";
   if (!run_rts) return;
   if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
-  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), sinks, run_batch ? nullptr : sinks.writer));
+  run->methods.push_back(DensifyAndScore("rts", std::move(*fr.rts), sinks, run_batch ? nullptr : sinks.writer, false));
   run->output_method = "rts";
   if (!run_batch) return;
   if (options.progress) {
     *options.progress << options.command << ": batch smoother (Ceres) started from the RTS solution\n";
   }
   Solution batch = RunBatch(inputs, config, run->methods.back().solution, &start, options.progress);
-  run->methods.push_back(DensifyAndScore("batch", std::move(batch), sinks, sinks.writer));
+  run->methods.push_back(DensifyAndScore("batch", std::move(batch), sinks, sinks.writer, true));
   run->output_method = "batch";
   RunAdaptedFilter(sinks, start, run);
 }
@@ -188,9 +204,11 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   run.inputs = SummarizeInputs(inputs);
   run.output_rate_hz = config.output_rate_hz;
   run.prior_std = InitialStdVector(config, config.filter.scale_factors ? ins::err::kSize21 : ins::err::kSize15);
+  AtomicFile gnss_csv(options.out_dir + "/gnss.csv");
+  WriteGnssCsv(gnss_csv.stream(), inputs.gnss, inputs.gnss_removed);
   NavOutputWriter writer(options.out_dir, config.filter.scale_factors);
-  ErrorFiles error_files;
-  RunEstimators(RunSinks{options, config, inputs, &writer, &error_files}, &run);
+  MethodFiles method_files;
+  RunEstimators(RunSinks{options, config, inputs, &writer, &method_files}, &run);
   run.output_epochs = writer.count();
   if (run.output_epochs == 0) throw std::runtime_error("the run produced no output epoch");
   run.warnings = Diagnose(run);
@@ -199,14 +217,17 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   }
   run.total_run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // summary.json first (it can still fail), then the per-method errors and the solution.
+  // summary.json first (it can still fail), then the method folders, gnss.csv and the solution.
   const std::string summary = options.out_dir + "/summary.json";
   WriteJsonFile(summary, [&](JsonWriter& w) { WriteRunSummary(w, options, run); });
   try {
-    for (const auto& f : error_files) f->Commit();
+    for (const auto& f : method_files) f->Commit();
+    gnss_csv.Commit();
     writer.Commit();
   } catch (...) {
-    for (const auto& f : error_files) f->Revoke();
+    for (const auto& f : method_files) f->Revoke();
+    gnss_csv.Revoke();
+    writer.Revoke();
     std::remove(summary.c_str());
     throw;
   }

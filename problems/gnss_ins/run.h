@@ -4,7 +4,9 @@
 // against a reference when one is given (so the score does not depend on the output
 // rate; each method's compared epochs go to <method>/errors.csv), and write the chosen
 // method's solution at the output epochs (nav.nav, nav.csv, std.csv, imu_errors.csv,
-// output.h) and summary.json into one folder, all or nothing.
+// output.h), every method's solution and measurement residuals (<method>/nav.csv, std.csv,
+// residuals.csv), the GNSS fixes read (gnss.csv) and summary.json into one folder, all or
+// nothing (docs/run-folder.md).
 // The JSON summary and the table of `navtwin navigate` / `navtwin smooth` come from here.
 #pragma once
 
@@ -85,7 +87,7 @@ struct GnssInsRun {
 };
 
 /// Runs options.methods over the record with `config` and writes the outputs and
-/// summary.json into options.out_dir (WriteRunSummary). A given initial state without a
+/// summary.json into options.out_dir (WriteRunSummary; docs/run-folder.md). A given initial state without a
 /// time starts at the first IMU interval. Nothing is left in the folder when it throws:
 /// InputError for bad input data, std::runtime_error when no output epoch results.
 GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config);

@@ -33,6 +33,18 @@ struct ResidualStats {
   double ChiSquarePerDof() const { return chi2 / dof; }
 };
 
+/// One measurement of an estimator (a row of <method>/residuals.csv, docs/run-folder.md).
+struct MeasurementResidual {
+  double t_s = 0.0;    ///< filter: the update epoch; batch: the time of the state it constrains
+  std::string sensor;  ///< the count key (Solution::counts)
+  int dof = 0;         ///< the measurement's dimension; 0 for a sample counted without an update
+  /// Filter: the NIS y^T S^-1 y of the update (rejected ones too); batch: the squared norm
+  /// of the whitened residual at the solution (with the variance components' noise, without
+  /// the robust loss); NaN for a sample counted without an update.
+  double chi2 = 0.0;
+  bool rejected = false;  ///< by the gate or a rule (counted as rejected)
+};
+
 struct Solution {
   std::string method;  ///< "filter", "rts", "batch"
   /// The estimator's state epochs ("knots"), increasing in time, with error-state standard
@@ -45,6 +57,10 @@ struct Solution {
   /// "gnss_position_v", ...; AidingSource::row_groups), and for the batch "imu" (the
   /// preintegrated increments), "gyro_bias_process", "accel_bias_process", "prior".
   std::map<std::string, ResidualStats> residuals;
+  /// Filter: one entry per counted sample (an update, accepted or rejected, a sample a rule
+  /// rejected, a reset), in time order. Batch: one per measurement residual block, in time
+  /// order. RTS: empty (it has no innovations of its own).
+  std::vector<MeasurementResidual> measurement_residuals;
   /// The epochs' auxiliary states (NavEpoch::aux; the aiding sources' parameters, e.g.
   /// "odometer_scale"), in order: names, priors and what observes them.
   std::vector<ins::AuxState> aux_states;

@@ -1,4 +1,5 @@
-// NavOutputWriter: the four files, their columns and units, and atomicity.
+// NavOutputWriter: the four files, their columns and units, and atomicity;
+// MethodOutputWriter (a method's folder) and gnss.csv.
 #include "problems/gnss_ins/output.h"
 
 #include <sys/stat.h>
@@ -158,6 +159,79 @@ TEST(NavOutputWriter, RejectsNonFiniteStates) {
   NavEpoch e = Epoch(1.0, 15);
   e.state.nav.h_m = std::nan("");
   EXPECT_THROW(w.Write(e), std::invalid_argument);
+}
+
+// A method's folder: nav.csv and std.csv the same lines as the top-level files, residuals.csv
+// with its nan and rejected fields; Revoke takes the committed files and the folder back.
+TEST(MethodOutputWriter, WritesTheMethodsFilesAndRevokesThem) {
+  const std::string dir = MakeTempDir();
+  NavOutputWriter top(dir, false);
+  MethodOutputWriter method(dir, "batch", false);
+  for (double t : {1.0, 2.0}) {
+    top.Write(Epoch(t, 15));
+    method.Write(Epoch(t, 15));
+  }
+  const double nan = std::nan("");
+  method.WriteResiduals({{1.5, "gnss_position", 3, 2.25, false}, {2.0, "baro", 0, nan, true}});
+  EXPECT_THROW(method.WriteResiduals({}), std::logic_error);
+  EXPECT_FALSE(Exists(dir + "/batch/nav.csv")) << "before the commit";
+  top.Commit();
+  method.Commit();
+  EXPECT_EQ(Lines(dir + "/batch/nav.csv"), Lines(dir + "/nav.csv"));
+  EXPECT_EQ(Lines(dir + "/batch/std.csv"), Lines(dir + "/std.csv"));
+  EXPECT_EQ(Lines(dir + "/batch/residuals.csv"),
+            (std::vector<std::string>{"t_s,sensor,dof,chi2,rejected", "1.5,gnss_position,3,2.25,0", "2,baro,0,nan,1"}));
+  EXPECT_FALSE(Exists(dir + "/batch/errors.csv")) << "only with OpenErrors";
+  method.Revoke();
+  top.Revoke();
+  EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
+}
+
+// A writer destroyed before Commit (a failed run) removes its files and the folder it made.
+TEST(MethodOutputWriter, NothingAppearsWithoutCommit) {
+  const std::string dir = MakeTempDir();
+  {
+    MethodOutputWriter w(dir, "filter", true);
+    w.Write(Epoch(1.0, 21));
+    w.OpenErrors(true);
+    w.WriteResiduals({});
+  }
+  EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
+}
+
+// gnss.csv: used and removed fixes merged in time order, sigmas as given (nan when none).
+TEST(WriteGnssCsv, MergesTheRemovedFixesInTimeOrder) {
+  GnssSample g;
+  g.lat_rad = 30.0 * kDegToRad;
+  g.lon_rad = 114.0 * kDegToRad;
+  g.h_m = 20.0;
+  g.pos_std_ned_m = Eigen::Vector3d(1.0, 1.5, 2.0);
+  std::vector<GnssSample> used(3, g), removed(2, g);
+  used[0].t_s = 1.0;
+  removed[0].t_s = 2.0;
+  removed[1].t_s = 3.0;
+  removed[1].pos_std_ned_m.setConstant(std::nan(""));
+  used[1].t_s = 4.0;
+  used[2].t_s = 5.0;
+  std::ostringstream out;
+  WriteGnssCsv(out, used, removed);
+  std::vector<std::string> lines;
+  std::stringstream in(out.str());
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  ASSERT_EQ(lines.size(), 6u);
+  EXPECT_EQ(lines[0], "t_s,lat_deg,lon_deg,h_m,pos_n_std_m,pos_e_std_m,pos_d_std_m,in_outage");
+  // Latitude and longitude pass through rad and back: compared to 1e-9 deg; the rest as text.
+  const char* const expected[5] = {"1,20,1,1.5,2,0", "2,20,1,1.5,2,1", "3,20,nan,nan,nan,1", "4,20,1,1.5,2,0",
+                                   "5,20,1,1.5,2,0"};
+  for (int i = 0; i < 5; ++i) {
+    std::vector<std::string> f;
+    std::stringstream ss(lines[static_cast<std::size_t>(i) + 1]);
+    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 8u) << lines[static_cast<std::size_t>(i) + 1];
+    EXPECT_NEAR(std::stod(f[1]), 30.0, 1e-9);
+    EXPECT_NEAR(std::stod(f[2]), 114.0, 1e-9);
+    EXPECT_EQ(f[0] + "," + f[3] + "," + f[4] + "," + f[5] + "," + f[6] + "," + f[7], expected[i]);
+  }
 }
 
 TEST(WriteJsonFile, WritesAtomically) {
