@@ -17,6 +17,7 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/io/atomic_file.h"
+#include "core/io/folder.h"
 #include "core/io/json_writer.h"
 #include "problems/leveling/monte_carlo.h"
 
@@ -139,9 +140,12 @@ void PrintText(const MonteCarloConfig& c, const MonteCarloResult& r) {
   }
 }
 
-void PrintJson(const MonteCarloResult& r) {
-  JsonWriter w(std::cout);
-  w.BeginObject().Field("runs", r.runs).Field("run_time_s", r.run_time_s);
+/// The --format=json object; in a run folder's summary.json led by "command".
+void WriteResultJson(std::ostream& out, const MonteCarloResult& r, bool with_command) {
+  JsonWriter w(out);
+  w.BeginObject();
+  if (with_command) w.Field("command", "level-mc");
+  w.Field("runs", r.runs).Field("run_time_s", r.run_time_s);
   w.Key("methods").BeginObject();
   for (const MethodStatistics& m : r.methods) {
     w.Key(m.method)
@@ -158,7 +162,17 @@ void PrintJson(const MonteCarloResult& r) {
         .EndObject();
   }
   w.EndObject().EndObject();
-  std::cout << "\n";
+  out << "\n";
+}
+
+/// --out DIR (docs/run-folder.md): DIR/summary.json and DIR/errors.csv (every run's errors).
+void WriteRunFolder(const MonteCarloResult& r) {
+  EnsureFolder(FLAGS_out);
+  WriteErrorsCsv(FLAGS_out + "/errors.csv", r);
+  AtomicFile summary(FLAGS_out + "/summary.json");
+  WriteResultJson(summary.stream(), r, true);
+  summary.Commit();
+  std::cerr << "level-mc: run folder " << FLAGS_out << " (summary.json, errors.csv)\n";
 }
 
 /// Progress on stderr in tenths of the runs (long experiments only).
@@ -196,12 +210,13 @@ int RunLevelMc(const std::vector<std::string>& args) {
   leveling::LevelingOptions options;
   options.batch_covariance = FLAGS_batch_covariance;
   leveling::MonteCarloRunOptions run_options;
-  run_options.keep_errors = !FLAGS_errors_csv.empty();
+  run_options.keep_errors = !FLAGS_errors_csv.empty() || !FLAGS_out.empty();
   run_options.progress = TenthsProgress(c.runs);
   const MonteCarloResult result = leveling::RunLevelingMonteCarlo(c, options, run_options);
   if (!FLAGS_errors_csv.empty()) WriteErrorsCsv(FLAGS_errors_csv, result);
+  if (!FLAGS_out.empty()) WriteRunFolder(result);
   if (FLAGS_format == "json") {
-    PrintJson(result);
+    WriteResultJson(std::cout, result, false);
   } else {
     PrintText(c, result);
   }
@@ -215,10 +230,10 @@ Command LevelMcCommand() {
           "Monte Carlo of leveling under rotor vibration (seed 000): every method's roll/pitch errors",
           "navtwin level-mc [--runs N] [--rate_hz 600] [--window_s 0.2] [--vib_axes x|xyz|x,y,z] "
           "[--vib_freq_hz 22:24] [--vib_amp_g 1] [--vib_tones 1] [--noise_mg 50] [--true_roll_deg 0] "
-          "[--true_pitch_deg 0] [--seed S] [--threads 2] [--errors_csv FILE] [--batch_covariance] "
+          "[--true_pitch_deg 0] [--seed S] [--threads 2] [--errors_csv FILE] [--out DIR] [--batch_covariance] "
           "[--format=json]",
           {"runs", "rate_hz", "window_s", "vib_axes", "vib_freq_hz", "vib_amp_g", "vib_tones", "noise_mg",
-           "true_roll_deg", "true_pitch_deg", "seed", "threads", "errors_csv", "batch_covariance"},
+           "true_roll_deg", "true_pitch_deg", "seed", "threads", "errors_csv", "out", "batch_covariance"},
           &RunLevelMc};
 }
 

@@ -74,6 +74,21 @@ TEST(LevelMcCliTest, ErrorsCsvHasOneRowPerRunMatchingTheJson) {
   ::rmdir(dir.c_str());
 }
 
+// --out DIR: the same errors.csv as --errors_csv, and summary.json the --format=json object
+// led by the command's name.
+TEST(LevelMcCliTest, OutWritesTheRunFolder) {
+  const std::string dir = MakeTempDir("level_mc_run") + "/run";
+  const RunResult r = Navtwin("level-mc --runs 25 --seed 9 --format=json --out " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string summary = ReadAll(dir + "/summary.json");
+  EXPECT_EQ(summary, "{\"command\":\"level-mc\"," + r.out.substr(1)) << summary;
+  std::istringstream in(ReadAll(dir + "/errors.csv"));
+  std::string line;
+  int rows = -1;
+  while (std::getline(in, line)) ++rows;
+  EXPECT_EQ(rows, 25);
+}
+
 TEST(LevelMcCliTest, BadFlagsAreUsageErrors) {
   for (const std::string flags :
        {"--runs 0", "--rate_hz 0", "--window_s 0.001", "--vib_freq_hz 24:22", "--vib_freq_hz 0:5",
