@@ -115,8 +115,8 @@ void InflightErrorFigure(const std::vector<InflightMethod>& methods, FigureSet* 
   Figure f;
   f.id = "heading_error";
   f.title = "Heading error against distance";
-  f.script = GnuplotCommon() + "set ylabel 'heading error [arcmin]'\nset xlabel 'distance flown [km]'\n" +
-             BandedErrorPlot(list, "h", &f);
+  f.script = GnuplotCommon() + "set ylabel 'heading error [arcmin]'\nset xlabel 'distance flown [km]'\n";
+  f.script += BandedErrorPlot(list, "h", &f);
   f.caption = "Heading error (estimate − truth, track.csv error_arcmin) of each method against the distance flown, "
               "with its ±3σ band (σ: sigma_arcmin) shaded in the same colour. The y range is clipped to 1.15 × the "
               "99th percentile of max(|error|, 3σ). Thinned uniformly.";

@@ -154,10 +154,10 @@ std::string TransferYRange(const std::vector<const std::vector<double>*>& values
 }
 
 /// One panel: per method the estimate (column `value` of the estimates) with its ±3σ band
-/// about it, and per folder its true value (`truth(m)`) as a dashed black line.
+/// about it (σ: column `sigma`), and per folder its true value (`truth(m)`) as a dashed black line.
 template <typename Truth>
-std::string TransferEstimatePanel(const std::vector<TransferMethod>& methods, std::size_t value, const std::string& block,
-                                  Truth truth, Figure* f) {
+std::string TransferEstimatePanel(const std::vector<TransferMethod>& methods, std::size_t value, std::size_t sigma,
+                                  const std::string& block, Truth truth, Figure* f) {
   std::string plots;
   std::vector<const std::vector<double>*> values;
   std::vector<double> lines;
@@ -165,7 +165,7 @@ std::string TransferEstimatePanel(const std::vector<TransferMethod>& methods, st
   for (std::size_t i = 0; i < methods.size(); ++i) {
     const TransferMethod& m = methods[i];
     const std::string name = block + std::to_string(i);
-    AppendDatablock(&f->script, name, {m.estimates.t, m.estimates.y[value], m.estimates.y[value + 3]});
+    AppendDatablock(&f->script, name, {m.estimates.t, m.estimates.y[value], m.estimates.y[sigma]});
     values.push_back(&m.estimates.y[value]);
     plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:($2-3*$3):($2+3*$3) w filledcurves fc rgb '" +
              m.color + "' fs transparent solid 0.15 noborder notitle, $" + name + " u 1:2 w l lw 1.3 lc rgb '" +
@@ -193,7 +193,7 @@ Figure TransferMisalignmentFigure(const std::vector<TransferMethod>& methods) {
     f.script += "set ylabel " + GnuplotQuote(std::string(kAxes[k]) + " misalignment [deg]") + "\n";
     f.script += k == 2 ? "set xlabel 'time [s]'\n" : "unset xlabel\n";
     f.script += k == 0 ? "" : "set key off\n";
-    f.script += TransferEstimatePanel(methods, k, "m" + std::to_string(k) + "_",
+    f.script += TransferEstimatePanel(methods, k, k + 3, "m" + std::to_string(k) + "_",
                                       [k](const TransferMethod& m) { return m.true_deg[k]; }, &f);
   }
   f.script += "unset multiplot\n";
@@ -209,7 +209,7 @@ Figure TransferDelayFigure(const std::vector<TransferMethod>& methods) {
   f.id = "delay";
   f.title = "Transfer delay estimate";
   f.script = GnuplotCommon() + "set ylabel 'delay [ms]'\nset xlabel 'time [s]'\n";
-  f.script += TransferEstimatePanel(methods, 6, "d", [](const TransferMethod& m) { return 1e3 * m.delay_true_s; }, &f);
+  f.script += TransferEstimatePanel(methods, 6, 7, "d", [](const TransferMethod& m) { return 1e3 * m.delay_true_s; }, &f);
   f.caption = "Estimated delay of the master's records (estimates.csv delay_s, in ms) against time with its ±3σ band; "
               "dashed black: the true delay (summary.json delay_true_s) when known. The y range spans the estimates "
               "and the true values. Thinned uniformly.";
