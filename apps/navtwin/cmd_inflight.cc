@@ -92,9 +92,9 @@ std::string OutlierText(const sim::Scenario& s) {
 
 const char* kAlignUsage =
     "navtwin inflight-align --imu F --gnss F [--baro F] --init_from NAV [--start_s T] [--truth NAV] "
-    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method distance|kalman|batch|all [--track_csv F] [--out DIR] [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method distance|kalman|batch|all [--track_csv F] [--out DIR [--report]] [--format=json]\n"
     "       navtwin inflight-align --scenario PRESET|YAML [--seed S] [--outlier_fraction P --outlier_m M] "
-    "[--config YAML] --method distance|kalman|batch|all [--track_csv F] [--out DIR] [--format=json]\n"
+    "[--config YAML] --method distance|kalman|batch|all [--track_csv F] [--out DIR [--report]] [--format=json]\n"
     "  The initial state is the record of --init_from at or after --start_s (default its first record);\n"
     "  heading errors need --truth (a scenario brings its own). Configuration keys: data/configs/\n"
     "  inflight-mach07-south.yaml. --method all runs the three (JSON: an array of the three objects).";
@@ -131,6 +131,7 @@ int RunInflightAlign(const std::vector<std::string>& args) {
   const auto usage = [](const std::string& why) { return Usage("inflight-align", kAlignUsage, why); };
   if (!args.empty()) return usage("unexpected argument '" + args[0] + "'");
   if (FLAGS_method.empty()) return usage("--method is required (distance, kalman, batch or all)");
+  if (FLAGS_report && FLAGS_out.empty()) return usage("--report needs --out DIR (it writes DIR/report.html)");
   std::vector<Method> methods;
   if (FLAGS_method == "all") {
     methods = kAllMethods;
@@ -195,6 +196,7 @@ int RunInflightAlign(const std::vector<std::string>& args) {
     }
   }
   if (!FLAGS_out.empty()) WriteInflightRunFolder(results);
+  if (!FLAGS_out.empty() && FLAGS_report) WriteRunReport("inflight-align", FLAGS_out);
   if (FLAGS_format == "json") {
     if (results.size() == 1) {
       std::cout << inflight::MethodResultJson(results.front()) << "\n";
@@ -341,7 +343,7 @@ Command InflightAlignCommand() {
           "In-flight heading alignment from the distance flown (seed 003): distance, kalman or batch",
           kAlignUsage,
           {"imu", "gnss", "baro", "init_from", "start_s", "truth", "config", "scenario", "seed", "method",
-           "track_csv", "outlier_fraction", "outlier_m", "calibration", "imu_temperature_degC", "out"},
+           "track_csv", "outlier_fraction", "outlier_m", "calibration", "imu_temperature_degC", "out", "report"},
           &RunInflightAlign};
 }
 

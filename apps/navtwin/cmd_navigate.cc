@@ -236,17 +236,6 @@ void ReportULogTimes(const Options& opt, const Files& files) {
   }
 }
 
-/// --report: OUT/report.html from the folder just written.
-void WriteRunReport(const Options& opt, const std::string& out_dir) {
-  report::ReportOptions options;
-  options.run_dirs = {out_dir};
-  options.out_path = out_dir + "/report.html";
-  options.progress = &std::cerr;
-  const report::ReportSummary summary = report::WriteReport(options);
-  std::cerr << opt.command << ": report " << options.out_path << " (" << summary.figures << " figures, "
-            << summary.run_time_s << " s)\n";
-}
-
 gnss_ins::RunMethods MethodsFromFlags(const Options& opt) {
   if (opt.command == "smooth") return gnss_ins::RunMethods::kAll;
   return FLAGS_smoother == "rts" ? gnss_ins::RunMethods::kFilterRts : gnss_ins::RunMethods::kFilter;
@@ -298,7 +287,7 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
   } else {
     std::cout << gnss_ins::RunTable(run_options, run);
   }
-  if (FLAGS_report) WriteRunReport(opt, files.out);
+  if (FLAGS_report) WriteRunReport(opt.command, files.out);
   return FLAGS_strict && !run.warnings.empty() ? kExitWarnings : kExitOk;
 }
 

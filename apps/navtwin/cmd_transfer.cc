@@ -36,9 +36,9 @@ using transfer::TransferResult;
 
 const char* kUsage =
     "navtwin transfer-align --master F --slave_imu F --init_from NAV [--start_s T] [--truth NAV] "
-    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|batch|all [--out DIR] [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|batch|all [--out DIR [--report]] [--format=json]\n"
     "       navtwin transfer-align --scenario PRESET|YAML [--seed S] [--delay_s X] [--config YAML] "
-    "--method order1|order2|batch|all [--out DIR] [--format=json]\n"
+    "--method order1|order2|batch|all [--out DIR [--report]] [--format=json]\n"
     "  The slave starts from the record of --init_from at or after --start_s (default: the start of the\n"
     "  slave IMU data), its mounting unknown (identity guess). Attitude errors need --truth (a scenario\n"
     "  brings its own, with the true mounting and delay). Configuration keys: data/configs/\n"
@@ -54,6 +54,7 @@ int Usage(const std::string& why) {
 int RunTransferAlign(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args[0] + "'");
   if (FLAGS_method.empty()) return Usage("--method is required (order1, order2, batch or all)");
+  if (FLAGS_report && FLAGS_out.empty()) return Usage("--report needs --out DIR (it writes DIR/report.html)");
   std::vector<Method> methods;
   if (FLAGS_method == "all") {
     methods = {Method::kOrder1, Method::kOrder2, Method::kBatch};
@@ -117,6 +118,7 @@ int RunTransferAlign(const std::vector<std::string>& args) {
     transfer::WriteTransferRunFolder(FLAGS_out, results);
     std::cerr << "transfer-align: run folder " << FLAGS_out << " (summary.json, <method>/estimates.csv"
               << (inputs.truth.empty() ? "" : ", <method>/attitude_errors.csv") << ")\n";
+    if (FLAGS_report) WriteRunReport("transfer-align", FLAGS_out);
   }
   if (FLAGS_format == "json") {
     if (results.size() == 1) {
@@ -143,7 +145,7 @@ Command TransferAlignCommand() {
           "Transfer alignment with misalignment and delay estimation (seed 002): order1, order2 or batch",
           kUsage,
           {"master", "slave_imu", "init_from", "start_s", "truth", "config", "scenario", "seed", "delay_s", "method",
-           "calibration", "imu_temperature_degC", "out"},
+           "calibration", "imu_temperature_degC", "out", "report"},
           &RunTransferAlign};
 }
 

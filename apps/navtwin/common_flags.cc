@@ -1,6 +1,9 @@
 #include "apps/navtwin/common_flags.h"
 
+#include "problems/report/report.h"
+
 #include <cmath>
+#include <iostream>
 
 DEFINE_string(format, "text", "Output format of printed results: text or json");
 DEFINE_string(out, "",
@@ -65,6 +68,16 @@ bool FlagGiven(const char* name) {
   // An unset flag whose default is NaN is not is_default either (NaN != NaN): its text
   // equals the default's, "nan".
   return !info.is_default && info.default_value != "nan";
+}
+
+void WriteRunReport(const std::string& command, const std::string& dir) {
+  report::ReportOptions options;
+  options.run_dirs = {dir};
+  options.out_path = dir + "/report.html";
+  options.progress = &std::cerr;
+  const report::ReportSummary summary = report::WriteReport(options);
+  std::cerr << command << ": report " << options.out_path << " (" << summary.figures << " figures, "
+            << summary.run_time_s << " s)\n";
 }
 
 }  // namespace navtwin::app

@@ -5,6 +5,8 @@
 
 #include <gflags/gflags.h>
 
+#include <string>
+
 // Output and run control.
 DECLARE_string(format);
 DECLARE_string(out);
@@ -14,6 +16,7 @@ DECLARE_int32(threads);
 DECLARE_string(errors_csv);
 DECLARE_string(method);
 DECLARE_bool(demo);
+DECLARE_bool(report);
 
 // Inputs.
 DECLARE_string(imu);
@@ -45,5 +48,9 @@ namespace navtwin::app {
 /// that it overrides a configuration file), or otherwise differs from its default.
 /// Unset flags with a NaN default count as not given (compared as text: NaN != NaN).
 bool FlagGiven(const char* name);
+
+/// --report: DIR/report.html from the run folder `dir` just written (navtwin report DIR),
+/// with the progress and the outcome on stderr prefixed by `command`.
+void WriteRunReport(const std::string& command, const std::string& dir);
 
 }  // namespace navtwin::app

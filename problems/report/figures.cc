@@ -19,8 +19,6 @@ struct Entry {
 };
 
 std::vector<Entry> Entries(const std::vector<RunData>& runs) {
-  static const char* const kPalette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b",
-                                         "#d62728", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};
   static const std::map<std::string, int> kMethodColor = {
       {"filter", 0}, {"rts", 1}, {"batch", 2}, {"filter_adapted", 3}, {"rts_adapted", 4}};
   std::vector<Entry> out;
@@ -29,16 +27,10 @@ std::vector<Entry> Entries(const std::vector<RunData>& runs) {
       const auto it = kMethodColor.find(m.method);
       const std::size_t k = runs.size() == 1 && it != kMethodColor.end() ? static_cast<std::size_t>(it->second)
                                                                           : out.size();
-      out.push_back({&run, &m, kPalette[k % 10]});
+      out.push_back({&run, &m, SeriesColor(k)});
     }
   }
   return out;
-}
-
-std::string FigureText(const char* format, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, x);
-  return buf;
 }
 
 /// The time origin of the figures: the first folder's start.
@@ -48,7 +40,7 @@ double TimeOrigin(const std::vector<RunData>& runs) {
 }
 
 std::string TimeLabel(double t0) {
-  return t0 == 0.0 ? "time [s]" : "time since " + FigureText("%.3f", t0) + " s [s]";
+  return t0 == 0.0 ? "time [s]" : "time since " + GnuplotNumber("%.3f", t0) + " s [s]";
 }
 
 std::vector<double> Shifted(const std::vector<double>& t, double t0) {
@@ -63,14 +55,12 @@ std::string OutageShading(const std::vector<RunData>& runs, double t0) {
   int k = 1;
   for (const RunData& run : runs) {
     for (const Outage& o : run.outages) {
-      s += "set object " + std::to_string(k++) + " rect from " + FigureText("%.9g", o.start_s - t0) + ", graph 0 to " +
-           FigureText("%.9g", o.end_s - t0) + ", graph 1 fc rgb '#e4e4e4' fs solid 1.0 noborder behind\n";
+      s += "set object " + std::to_string(k++) + " rect from " + GnuplotNumber("%.9g", o.start_s - t0) + ", graph 0 to " +
+           GnuplotNumber("%.9g", o.end_s - t0) + ", graph 1 fc rgb '#e4e4e4' fs solid 1.0 noborder behind\n";
     }
   }
   return s;
 }
-
-std::string Common() { return "set grid lc rgb '#d0d0d0'\nset key top right opaque box lc rgb '#c0c0c0' font ',10'\n"; }
 
 std::string OutageNote(const std::vector<RunData>& runs) {
   for (const RunData& r : runs) {
@@ -157,13 +147,13 @@ Figure TrackFigure(const std::vector<RunData>& runs, const std::vector<Entry>& e
     ++f.series;
   }
   if (plots.rfind(", ", 0) == 0) plots = plots.substr(2);
-  f.script += Common() + "set size ratio -1\nset xlabel 'east [m]'\nset ylabel 'north [m]'\n"
+  f.script += GnuplotCommon() + "set size ratio -1\nset xlabel 'east [m]'\nset ylabel 'north [m]'\n"
               "set key outside right top\nplot " + plots + "\n";
   bool fixes = false;
   for (const RunData& r : runs) fixes = fixes || (r.has_gnss && !r.gnss.t.empty());
   f.caption = "East and north of each method's navigation solution (nav.csv) and of the GNSS fixes (gnss.csv), in "
-              "metres from the first " + std::string(fixes ? "GNSS fix" : "navigation epoch (no gnss.csv)") + " (" + FigureText("%.7f", origin.lat_rad * kRadToDeg) + "°, " +
-              FigureText("%.7f", origin.lon_rad * kRadToDeg) + "°). Red crosses: fixes removed by the injected outages "
+              "metres from the first " + std::string(fixes ? "GNSS fix" : "navigation epoch (no gnss.csv)") + " (" + GnuplotNumber("%.7f", origin.lat_rad * kRadToDeg) + "°, " +
+              GnuplotNumber("%.7f", origin.lon_rad * kRadToDeg) + "°). Red crosses: fixes removed by the injected outages "
               "(the outage spans). Points thinned uniformly to at most a few thousand per series.";
   return f;
 }
@@ -184,26 +174,13 @@ constexpr ComponentGroup kGroups[3] = {
 
 /// One panel of an error figure: per method the ±3σ band and the error.
 std::string ErrorPanel(const std::vector<Entry>& entries, int c, double t0, Figure* f) {
-  std::string plots;
-  double limit = 0.0;
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    const MethodData& m = *entries[i].m;
+  std::vector<BandedSeries> list;
+  for (const Entry& e : entries) {
+    const MethodData& m = *e.m;
     if (!m.has_errors || !m.compared[c]) continue;
-    const Series& s = m.errors[c];
-    const std::string name = "e" + std::to_string(c) + "_" + std::to_string(i);
-    AppendDatablock(&f->script, name, {Shifted(s.t, t0), s.y[0], s.y[1]});
-    std::vector<double> envelope(s.y[0].size());
-    for (std::size_t k = 0; k < envelope.size(); ++k) envelope[k] = std::max(std::abs(s.y[0][k]), 3.0 * s.y[1][k]);
-    const double p = AbsPercentile(envelope, 0.99);
-    if (std::isfinite(p)) limit = std::max(limit, p);
-    plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:(-3*$3):(3*$3) w filledcurves fc rgb '" +
-             entries[i].color + "' fs transparent solid 0.12 noborder notitle, $" + name + " u 1:2 w l lw 1.2 lc rgb '" +
-             entries[i].color + "' title " + GnuplotQuote(m.label);
-    f->series += 2;
+    list.push_back({m.label, e.color, Shifted(m.errors[c].t, t0), m.errors[c].y[0], m.errors[c].y[1]});
   }
-  std::string s = limit > 0.0 ? "set yrange [" + FigureText("%.6g", -1.15 * limit) + ":" + FigureText("%.6g", 1.15 * limit) + "]\n"
-                              : "set autoscale y\n";
-  return s + "plot " + plots + "\n";
+  return BandedErrorPlot(list, "e" + std::to_string(c) + "_", f);
 }
 
 bool ComponentPlotted(const std::vector<Entry>& entries, int c) {
@@ -230,7 +207,7 @@ void ErrorFigures(const std::vector<RunData>& runs, const std::vector<Entry>& en
     f.id = g.id;
     f.title = g.title;
     f.height_px = 820;
-    f.script = Common() + OutageShading(runs, t0) + "set multiplot layout 3,1\nset lmargin 12\n";
+    f.script = GnuplotCommon() + OutageShading(runs, t0) + "set multiplot layout 3,1\nset lmargin 12\n";
     for (int k = 0; k < 3; ++k) {
       f.script += "set ylabel " + GnuplotQuote(std::string(g.names[k]) + " error [" + g.unit + "]") + "\n";
       f.script += k == 2 ? "set xlabel " + GnuplotQuote(TimeLabel(t0)) + "\n" : "unset xlabel\n";
@@ -252,7 +229,7 @@ Figure SigmaFigure(const std::vector<RunData>& runs, const std::vector<Entry>& e
   f.id = "sigma";
   f.title = "Standard deviations";
   f.height_px = 820;
-  f.script = Common() + OutageShading(runs, t0) + "set multiplot layout 3,1\nset lmargin 12\nset logscale y\n";
+  f.script = GnuplotCommon() + OutageShading(runs, t0) + "set multiplot layout 3,1\nset lmargin 12\nset logscale y\n";
   static const char* const kLabels[3] = {"position σ [m]", "velocity σ [m/s]", "attitude σ [deg]"};
   for (int g = 0; g < 3; ++g) {
     f.script += "set ylabel " + GnuplotQuote(kLabels[g]) + "\n";
@@ -286,7 +263,7 @@ struct SensorEntry {
 std::string BoundsText(const BoundsCount& c) {
   if (c.values == 0) return "no values";
   const double outside = 100.0 * static_cast<double>(c.below + c.above) / static_cast<double>(c.values);
-  return FigureText("%.1f %% outside", outside) + " (" + std::to_string(c.below) + " below, " + std::to_string(c.above) +
+  return GnuplotNumber("%.1f %% outside", outside) + " (" + std::to_string(c.below) + " below, " + std::to_string(c.above) +
          " above, of " + std::to_string(c.values) + ")";
 }
 
@@ -295,7 +272,7 @@ Figure NisFigure(const std::string& sensor, const std::vector<SensorEntry>& list
   Figure f;
   f.id = "nis_" + sensor;
   f.title = "Residuals: " + sensor;
-  f.script = Common() + OutageShading(runs, t0) + "set logscale y\nset ylabel 'NIS / whitened χ² per update'\n" +
+  f.script = GnuplotCommon() + OutageShading(runs, t0) + "set logscale y\nset ylabel 'NIS / whitened χ² per update'\n" +
              "set xlabel " + GnuplotQuote(TimeLabel(t0)) + "\n";
   std::string plots, counts;
   std::vector<int> dofs;
@@ -324,8 +301,8 @@ Figure NisFigure(const std::string& sensor, const std::vector<SensorEntry>& list
   for (std::size_t k = 0; k < shown; ++k) {
     const std::array<double, 2> b = ChiSquareBounds95(dofs[k]);
     const std::string style = " w l lw 1.5 dt " + std::to_string(kDash[k]) + " lc rgb '#000000' ";
-    plots += ", " + FigureText("%.6g", b[0]) + style + "title " +
-             GnuplotQuote("χ²(" + std::to_string(dofs[k]) + ") 95 % bounds") + ", " + FigureText("%.6g", b[1]) + style +
+    plots += ", " + GnuplotNumber("%.6g", b[0]) + style + "title " +
+             GnuplotQuote("χ²(" + std::to_string(dofs[k]) + ") 95 % bounds") + ", " + GnuplotNumber("%.6g", b[1]) + style +
              "notitle";
     f.series += 2;
   }
@@ -359,7 +336,7 @@ void NeesFigure(const std::vector<RunData>& runs, const std::vector<Entry>& entr
   Figure f;
   f.id = "nees";
   f.title = "Position NEES";
-  f.script = Common() + OutageShading(runs, t0) + "set logscale y\nset ylabel 'position NEES'\nset xlabel " +
+  f.script = GnuplotCommon() + OutageShading(runs, t0) + "set logscale y\nset ylabel 'position NEES'\nset xlabel " +
              GnuplotQuote(TimeLabel(t0)) + "\n";
   std::string plots, counts;
   for (std::size_t i = 0; i < entries.size(); ++i) {
@@ -377,13 +354,13 @@ void NeesFigure(const std::vector<RunData>& runs, const std::vector<Entry>& entr
     return;
   }
   const std::array<double, 2> b = ChiSquareBounds95(3);
-  plots += ", " + FigureText("%.6g", b[0]) + " w l lw 1.5 dt 2 lc rgb '#000000' title 'χ²(3) 95 % bounds', " +
-           FigureText("%.6g", b[1]) + " w l lw 1.5 dt 2 lc rgb '#000000' notitle";
+  plots += ", " + GnuplotNumber("%.6g", b[0]) + " w l lw 1.5 dt 2 lc rgb '#000000' title 'χ²(3) 95 % bounds', " +
+           GnuplotNumber("%.6g", b[1]) + " w l lw 1.5 dt 2 lc rgb '#000000' notitle";
   f.series += 2;
   f.script += "plot " + plots + "\n";
   f.caption = "Position NEES at every compared epoch: Σ (error/σ)² over north, east, down with diagonal σ (combined "
               "with the reference's σ when it has one), log scale, against the two-sided 95 % bounds of χ²(3) (" +
-              FigureText("%.3f", b[0]) + ", " + FigureText("%.3f", b[1]) + "). " + counts +
+              GnuplotNumber("%.3f", b[0]) + ", " + GnuplotNumber("%.3f", b[1]) + "). " + counts +
               ". Thinned keeping each bucket's extremes; the counts are over every epoch." + OutageNote(runs);
   out->figures.push_back(std::move(f));
 }
@@ -411,19 +388,19 @@ void DriftFigure(const std::vector<RunData>& runs, const std::vector<Entry>& ent
   Figure f;
   f.id = "drift";
   f.title = "Drift per outage";
-  f.script = Common() + "set style data histogram\nset style histogram clustered gap 1\n"
+  f.script = GnuplotCommon() + "set style data histogram\nset style histogram clustered gap 1\n"
              "set style fill solid 0.85 noborder\nset boxwidth 0.9\nset yrange [0:*]\n"
              "set ylabel 'max horizontal error in the outage [m]'\nset xlabel " +
-             GnuplotQuote("outage: start – end [s]" + (t0 == 0.0 ? "" : " since " + FigureText("%.3f", t0) + " s")) + "\nset xtics rotate by -30\n";
+             GnuplotQuote("outage: start – end [s]" + (t0 == 0.0 ? "" : " since " + GnuplotNumber("%.3f", t0) + " s")) + "\nset xtics rotate by -30\n";
   f.script += "$d << EOD\n";
   for (const Outage& o : spans) {
-    f.script += "\"" + FigureText("%.1f", o.start_s - t0) + "–" + FigureText("%.1f", o.end_s - t0) + "\"";
+    f.script += "\"" + GnuplotNumber("%.1f", o.start_s - t0) + "–" + GnuplotNumber("%.1f", o.end_s - t0) + "\"";
     for (const Entry* e : plotted) {
       double v = std::nan("");
       for (std::size_t k = 0; k < e->run->outages.size(); ++k) {
         if (std::abs(e->run->outages[k].start_s - o.start_s) < 1e-6) v = e->m->outage_max_horizontal_m[k];
       }
-      f.script += std::isfinite(v) ? " " + FigureText("%.9g", v) : " NaN";
+      f.script += std::isfinite(v) ? " " + GnuplotNumber("%.9g", v) : " NaN";
     }
     f.script += "\n";
   }
@@ -440,6 +417,36 @@ void DriftFigure(const std::vector<RunData>& runs, const std::vector<Entry>& ent
 }
 
 }  // namespace
+
+std::string BandedErrorPlot(const std::vector<BandedSeries>& list, const std::string& prefix, Figure* f) {
+  std::string plots;
+  double limit = 0.0;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const BandedSeries& b = list[i];
+    const bool band = !b.sigma.empty();
+    const std::string name = prefix + std::to_string(i);
+    AppendDatablock(&f->script, name, band ? std::vector<std::vector<double>>{b.x, b.y, b.sigma}
+                                           : std::vector<std::vector<double>>{b.x, b.y});
+    std::vector<double> envelope(b.y.size());
+    for (std::size_t k = 0; k < envelope.size(); ++k) {
+      envelope[k] = band ? std::max(std::abs(b.y[k]), 3.0 * b.sigma[k]) : b.y[k];
+    }
+    const double p = AbsPercentile(envelope, 0.99);
+    if (std::isfinite(p)) limit = std::max(limit, p);
+    if (band) {
+      plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:(-3*$3):(3*$3) w filledcurves fc rgb '" +
+               b.color + "' fs transparent solid 0.12 noborder notitle";
+      ++f->series;
+    }
+    plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:2 w l lw 1.2 lc rgb '" + b.color +
+             "' title " + GnuplotQuote(b.label);
+    ++f->series;
+  }
+  std::string s = limit > 0.0 ? "set yrange [" + GnuplotNumber("%.6g", -1.15 * limit) + ":" +
+                                    GnuplotNumber("%.6g", 1.15 * limit) + "]\n"
+                              : "set autoscale y\n";
+  return s + "plot " + plots + "\n";
+}
 
 FigureSet BuildFigures(const std::vector<RunData>& runs) {
   FigureSet out;

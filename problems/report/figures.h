@@ -16,6 +16,22 @@ struct FigureSet {
   std::vector<std::string> left_out;  ///< "figure: why", one per figure not made
 };
 
+/// The GNSS/INS figures (navigate, smooth folders).
 FigureSet BuildFigures(const std::vector<RunData>& runs);
+
+/// One plotted error series: x, the error and its σ (empty: no band).
+struct BandedSeries {
+  std::string label;
+  std::string color;
+  std::vector<double> x;
+  std::vector<double> y;
+  std::vector<double> sigma;
+};
+
+/// The plot command of errors about zero: per series its ±3σ band shaded in its colour (when
+/// it has σ) and its line, the y range clipped to 1.15 × the 99th percentile of
+/// max(|error|, 3σ) over all series. Appends the datablocks `prefix`0, 1, ... to f->script
+/// and counts the plot elements in f->series.
+std::string BandedErrorPlot(const std::vector<BandedSeries>& list, const std::string& prefix, Figure* f);
 
 }  // namespace navtwin::report

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -83,6 +84,22 @@ std::string FullScript(const Figure& f, const std::string& svg_path) {
 }
 
 }  // namespace
+
+std::string GnuplotNumber(const char* format, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, x);
+  return buf;
+}
+
+std::string GnuplotCommon() {
+  return "set grid lc rgb '#d0d0d0'\nset key top right opaque box lc rgb '#c0c0c0' font ',10'\n";
+}
+
+const char* SeriesColor(std::size_t k) {
+  static const char* const kPalette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b",
+                                         "#d62728", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};
+  return kPalette[k % 10];
+}
 
 std::string GnuplotQuote(const std::string& text) {
   std::string out = "'";

@@ -24,6 +24,15 @@ struct Figure {
 /// NaN, which gnuplot leaves out), "EOD".
 void AppendDatablock(std::string* script, const std::string& name, const std::vector<std::vector<double>>& columns);
 
+/// x formatted with the printf `format` (for scripts and captions).
+std::string GnuplotNumber(const char* format, double x);
+
+/// The settings every figure starts with: the grid and the key's box.
+std::string GnuplotCommon();
+
+/// The k-th colour of the report's palette (ten colours, repeating).
+const char* SeriesColor(std::size_t k);
+
 /// A gnuplot single-quoted string ('' for a quote).
 std::string GnuplotQuote(const std::string& text);
 

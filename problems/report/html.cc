@@ -37,28 +37,30 @@ window.addEventListener('load', function () {
 });
 </script>)";
 
-std::string CellText(const char* format, double x) {
+}  // namespace
+
+std::string HtmlNumber(const char* format, double x) {
   if (!std::isfinite(x)) return "–";
   char buf[64];
   std::snprintf(buf, sizeof buf, format, x);
   return buf;
 }
 
-/// A number cell; `bad` marks it.
-std::string Cell(double x, const char* format = "%.4g", bool bad = false) {
-  return std::string(bad ? "<td class=\"bad\">" : "<td>") + CellText(format, x) + "</td>";
+std::string HtmlCell(double x, const char* format, bool bad) {
+  return std::string(bad ? "<td class=\"bad\">" : "<td>") + HtmlNumber(format, x) + "</td>";
 }
 
-std::string NameCell(const std::string& text) { return "<td class=\"name\">" + HtmlEscape(text) + "</td>"; }
+std::string HtmlNameCell(const std::string& text) { return "<td class=\"name\">" + HtmlEscape(text) + "</td>"; }
 
-/// The header row; the first `text_columns` columns hold names (left-aligned).
-std::string Head(const std::vector<std::string>& names, std::size_t text_columns = 1) {
+std::string HtmlHead(const std::vector<std::string>& names, std::size_t text_columns) {
   std::string s = "<tr>";
   for (std::size_t i = 0; i < names.size(); ++i) {
     s += std::string(i < text_columns ? "<th class=\"name\">" : "<th>") + HtmlEscape(names[i]) + "</th>";
   }
   return s + "</tr>\n";
 }
+
+namespace {
 
 std::string MethodName(const RunData& run, const std::string& method, bool several) {
   return several ? run.label + "/" + method : method;
@@ -70,19 +72,19 @@ double SummaryNumber(const RunData& run, const YAML::Node& node, const std::stri
 
 std::string InputsSection(const std::vector<RunData>& runs) {
   std::string s = "<h2 id=\"inputs\">Runs</h2>\n<table>" +
-                  Head({"folder", "command", "output", "IMU samples", "GNSS epochs", "removed by outages", "outages",
+                  HtmlHead({"folder", "command", "output", "IMU samples", "GNSS epochs", "removed by outages", "outages",
                         "span [s]", "reference"}, 3);
   for (const RunData& r : runs) {
     const YAML::Node in = JsonChild(r.summary, "inputs");
     const std::string p = r.summary_path;
-    s += "<tr>" + NameCell(r.dir) + NameCell(JsonChild(r.summary, "command") ? JsonChild(r.summary, "command").Scalar() : "") +
-         NameCell(r.output_method) + Cell(JsonNumber(JsonChild(in, "imu_samples"), p, "inputs.imu_samples"), "%.0f") +
-         Cell(JsonNumber(JsonChild(in, "gnss_epochs"), p, "inputs.gnss_epochs"), "%.0f") +
-         Cell(JsonNumber(JsonChild(in, "gnss_removed_by_outages"), p, "inputs.gnss_removed_by_outages"), "%.0f") +
-         Cell(static_cast<double>(r.outages.size()), "%.0f") +
-         Cell(JsonNumber(JsonChild(in, "t_end_s"), p, "inputs.t_end_s") - JsonNumber(JsonChild(in, "t_start_s"), p, "inputs.t_start_s"),
+    s += "<tr>" + HtmlNameCell(r.dir) + HtmlNameCell(JsonChild(r.summary, "command") ? JsonChild(r.summary, "command").Scalar() : "") +
+         HtmlNameCell(r.output_method) + HtmlCell(JsonNumber(JsonChild(in, "imu_samples"), p, "inputs.imu_samples"), "%.0f") +
+         HtmlCell(JsonNumber(JsonChild(in, "gnss_epochs"), p, "inputs.gnss_epochs"), "%.0f") +
+         HtmlCell(JsonNumber(JsonChild(in, "gnss_removed_by_outages"), p, "inputs.gnss_removed_by_outages"), "%.0f") +
+         HtmlCell(static_cast<double>(r.outages.size()), "%.0f") +
+         HtmlCell(JsonNumber(JsonChild(in, "t_end_s"), p, "inputs.t_end_s") - JsonNumber(JsonChild(in, "t_start_s"), p, "inputs.t_start_s"),
               "%.1f") +
-         NameCell(JsonChild(r.summary, "truth") ? JsonChild(r.summary, "truth").Scalar() : "none") + "</tr>\n";
+         HtmlNameCell(JsonChild(r.summary, "truth") ? JsonChild(r.summary, "truth").Scalar() : "none") + "</tr>\n";
   }
   return s + "</table>\n";
 }
@@ -106,22 +108,22 @@ std::string ErrorsTable(const std::vector<RunData>& runs) {
       if (!e) continue;
       const YAML::Node all = JsonChild(e, "all");
       const std::string k = "methods." + kv.first.Scalar() + ".errors.";
-      rows += "<tr>" + NameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) +
-              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "horizontal_m"), "rms"), k + "all.horizontal_m.rms")) +
-              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "horizontal_m"), "max"), k + "all.horizontal_m.max")) +
-              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "vertical_m"), "rms"), k + "all.vertical_m.rms")) +
-              Cell(SummaryNumber(r, JsonChild(all, "velocity_rms_mps"), k + "all.velocity_rms_mps")) +
-              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "roll_deg"), "rms"), k + "all.roll_deg.rms")) +
-              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "pitch_deg"), "rms"), k + "all.pitch_deg.rms")) +
-              Cell(SummaryNumber(r, JsonChild(JsonChild(all, "yaw_deg"), "rms"), k + "all.yaw_deg.rms")) +
-              Cell(SummaryNumber(r, JsonChild(e, "outage_horizontal_rms_m"), k + "outage_horizontal_rms_m")) +
-              Cell(SummaryNumber(r, JsonChild(e, "outage_vertical_rms_m"), k + "outage_vertical_rms_m")) +
-              Cell(SummaryNumber(r, JsonChild(kv.second, "run_time_s"), "methods." + kv.first.Scalar() + ".run_time_s"), "%.2f") + "</tr>\n";
+      rows += "<tr>" + HtmlNameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) +
+              HtmlCell(SummaryNumber(r, JsonChild(JsonChild(all, "horizontal_m"), "rms"), k + "all.horizontal_m.rms")) +
+              HtmlCell(SummaryNumber(r, JsonChild(JsonChild(all, "horizontal_m"), "max"), k + "all.horizontal_m.max")) +
+              HtmlCell(SummaryNumber(r, JsonChild(JsonChild(all, "vertical_m"), "rms"), k + "all.vertical_m.rms")) +
+              HtmlCell(SummaryNumber(r, JsonChild(all, "velocity_rms_mps"), k + "all.velocity_rms_mps")) +
+              HtmlCell(SummaryNumber(r, JsonChild(JsonChild(all, "roll_deg"), "rms"), k + "all.roll_deg.rms")) +
+              HtmlCell(SummaryNumber(r, JsonChild(JsonChild(all, "pitch_deg"), "rms"), k + "all.pitch_deg.rms")) +
+              HtmlCell(SummaryNumber(r, JsonChild(JsonChild(all, "yaw_deg"), "rms"), k + "all.yaw_deg.rms")) +
+              HtmlCell(SummaryNumber(r, JsonChild(e, "outage_horizontal_rms_m"), k + "outage_horizontal_rms_m")) +
+              HtmlCell(SummaryNumber(r, JsonChild(e, "outage_vertical_rms_m"), k + "outage_vertical_rms_m")) +
+              HtmlCell(SummaryNumber(r, JsonChild(kv.second, "run_time_s"), "methods." + kv.first.Scalar() + ".run_time_s"), "%.2f") + "</tr>\n";
     }
   }
   if (rows.empty()) return "<p class=\"note\">No errors: the runs had no reference (--truth).</p>\n";
   return "<h3>Errors (RMS over every compared epoch; drift: RMS over the outages of the per-outage maximum)</h3>\n<table>" +
-         Head({"method", "horiz. RMS [m]", "horiz. max [m]", "vert. RMS [m]", "vel. RMS [m/s]", "roll [deg]",
+         HtmlHead({"method", "horiz. RMS [m]", "horiz. max [m]", "vert. RMS [m]", "vel. RMS [m/s]", "roll [deg]",
                "pitch [deg]", "yaw [deg]", "drift H [m]", "drift V [m]", "run [s]"}) +
          rows + "</table>\n";
 }
@@ -140,19 +142,19 @@ std::string ConsistencyTable(const std::vector<RunData>& runs) {
         const YAML::Node s = JsonChild(c, scope);
         if (!s) continue;
         const std::string k = "methods." + kv.first.Scalar() + ".errors.consistency." + scope + ".";
-        rows += "<tr>" + NameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) + NameCell(scope) +
-                Cell(SummaryNumber(r, JsonChild(s, "epochs"), k + "epochs"), "%.0f");
+        rows += "<tr>" + HtmlNameCell(MethodName(r, kv.first.Scalar(), runs.size() > 1)) + HtmlNameCell(scope) +
+                HtmlCell(SummaryNumber(r, JsonChild(s, "epochs"), k + "epochs"), "%.0f");
         for (const char* key : kKeys) {
           const double v = SummaryNumber(r, JsonChild(s, key), k + key);
-          rows += Cell(v, "%.2f", Dishonest(v));
+          rows += HtmlCell(v, "%.2f", Dishonest(v));
         }
-        rows += Cell(SummaryNumber(r, JsonChild(s, "pos_nees_mean"), k + "pos_nees_mean"), "%.2f") + "</tr>\n";
+        rows += HtmlCell(SummaryNumber(r, JsonChild(s, "pos_nees_mean"), k + "pos_nees_mean"), "%.2f") + "</tr>\n";
       }
     }
   }
   if (rows.empty()) return "";
   return "<h3>err/σ (RMS; 1 = honest σ; red beyond 3 or below 1/3) and mean position NEES (expected 3)</h3>\n<table>" +
-         Head({"method", "scope", "epochs", "pos N", "pos E", "pos D", "vel N", "vel E", "vel D", "roll", "pitch",
+         HtmlHead({"method", "scope", "epochs", "pos N", "pos E", "pos D", "vel N", "vel E", "vel D", "roll", "pitch",
                "yaw", "NEES pos"}, 2) +
          rows + "</table>\n";
 }
@@ -171,19 +173,19 @@ std::string ResidualsTable(const std::vector<RunData>& runs) {
                                       : SummaryNumber(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof");
         const bool adapted = JsonChild(v, "adapted") && JsonChild(v, "adapted").Scalar() == "true";
         const YAML::Node count = JsonChild(JsonChild(kv.second, "counts"), g.first.Scalar());
-        rows += "<tr>" + NameCell(MethodName(r, m, runs.size() > 1)) + NameCell(g.first.Scalar()) +
-                Cell(SummaryNumber(r, JsonChild(v, "rows"), k + "rows"), "%.0f") + Cell(dof, "%.1f") +
-                Cell(count ? SummaryNumber(r, JsonChild(count, "rejected"), "counts.rejected") : std::nan(""), "%.0f") +
-                Cell(dof >= 1.0 ? configured : std::nan(""), "%.3f", dof >= 10.0 && configured > 3.0) +
-                Cell(adapted ? SummaryNumber(r, JsonChild(v, "sigma_scale"), k + "sigma_scale") : std::nan(""), "%.3f") +
-                Cell(adapted ? SummaryNumber(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof") : std::nan(""), "%.3f") + "</tr>\n";
+        rows += "<tr>" + HtmlNameCell(MethodName(r, m, runs.size() > 1)) + HtmlNameCell(g.first.Scalar()) +
+                HtmlCell(SummaryNumber(r, JsonChild(v, "rows"), k + "rows"), "%.0f") + HtmlCell(dof, "%.1f") +
+                HtmlCell(count ? SummaryNumber(r, JsonChild(count, "rejected"), "counts.rejected") : std::nan(""), "%.0f") +
+                HtmlCell(dof >= 1.0 ? configured : std::nan(""), "%.3f", dof >= 10.0 && configured > 3.0) +
+                HtmlCell(adapted ? SummaryNumber(r, JsonChild(v, "sigma_scale"), k + "sigma_scale") : std::nan(""), "%.3f") +
+                HtmlCell(adapted ? SummaryNumber(r, JsonChild(v, "chi2_per_dof"), k + "chi2_per_dof") : std::nan(""), "%.3f") + "</tr>\n";
       }
     }
   }
   if (rows.empty()) return "";
   return "<h3>Residual statistics (whitened; χ²/dof near 1 when the noise fits; batch: σ scale from the variance "
          "components)</h3>\n<table>" +
-         Head({"method", "group", "rows", "dof", "rejected", "χ²/dof configured", "σ scale", "χ²/dof adapted"}, 2) + rows +
+         HtmlHead({"method", "group", "rows", "dof", "rejected", "χ²/dof configured", "σ scale", "χ²/dof adapted"}, 2) + rows +
          "</table>\n";
 }
 
@@ -237,9 +239,9 @@ std::string ParameterCell(const RunData& r, const std::string& m, const std::str
   const std::string k = "methods." + m + "." + kind + "." + name + ".";
   const double value = SummaryNumber(r, JsonChild(p, "value"), k + "value") * scale, std = SummaryNumber(r, JsonChild(p, "std"), k + "std") * scale;
   if (JsonChild(p, "observable") && JsonChild(p, "observable").Scalar() == "false") {
-    return "<td class=\"bad\">not observable (" + CellText("%.4g", value) + " ± " + CellText("%.2g", std) + ")</td>";
+    return "<td class=\"bad\">not observable (" + HtmlNumber("%.4g", value) + " ± " + HtmlNumber("%.2g", std) + ")</td>";
   }
-  return "<td>" + CellText("%.4g", value) + " ± " + CellText("%.2g", std) + "</td>";
+  return "<td>" + HtmlNumber("%.4g", value) + " ± " + HtmlNumber("%.2g", std) + "</td>";
 }
 
 /// Per folder: one row per parameter (auxiliary states, IMU scale factors), one column per method.
@@ -260,9 +262,9 @@ std::string ParametersTable(const std::vector<RunData>& runs) {
     if (params.empty()) continue;
     std::vector<std::string> head = {"parameter"};
     head.insert(head.end(), methods.begin(), methods.end());
-    out += (runs.size() > 1 ? "<p>" + HtmlEscape(r.label) + ":</p>" : std::string()) + "<table>" + Head(head);
+    out += (runs.size() > 1 ? "<p>" + HtmlEscape(r.label) + ":</p>" : std::string()) + "<table>" + HtmlHead(head);
     for (const auto& [kind, name] : params) {
-      out += "<tr>" + NameCell(name + (kind == "imu_scale_factors" ? " [ppm]" : ""));
+      out += "<tr>" + HtmlNameCell(name + (kind == "imu_scale_factors" ? " [ppm]" : ""));
       for (const std::string& m : methods) out += ParameterCell(r, m, kind, name);
       out += "</tr>\n";
     }
@@ -299,41 +301,48 @@ std::string FigureHtml(const Figure& f) {
          "\">\n<figcaption>" + HtmlEscape(f.caption) + "</figcaption>\n</figure>\n";
 }
 
-std::string Contents(const std::vector<Figure>& figures) {
-  std::string s = "<nav><ul>\n<li><a href=\"#inputs\">Runs</a></li><li><a href=\"#warnings\">Warnings</a></li>"
-                  "<li><a href=\"#tables\">Summary tables</a></li>\n";
+std::string Contents(const std::vector<PageSection>& sections, const std::vector<Figure>& figures) {
+  std::string s = "<nav><ul>\n";
+  for (const PageSection& p : sections) s += "<li><a href=\"#" + Anchor(p.id) + "\">" + HtmlEscape(p.title) + "</a></li>";
+  s += "\n";
   for (const Figure& f : figures) s += "<li><a href=\"#" + Anchor(f.id) + "\">" + HtmlEscape(f.title) + "</a></li>\n";
   return s + "<li><a href=\"#left_out\">Left out</a></li></ul></nav>\n";
 }
 
-std::string LeftOutSection(const std::vector<RunData>& runs, const std::vector<std::string>& left_out) {
+std::string LeftOutSection(const std::vector<std::string>& left_out, const std::vector<std::string>& notes) {
   std::string s = "<h2 id=\"left_out\">Left out</h2>\n";
   std::string items;
   for (const std::string& why : left_out) items += "<li>" + HtmlEscape(why) + "</li>\n";
-  for (const RunData& r : runs) {
-    for (const std::string& n : r.notes) items += "<li class=\"note\">" + HtmlEscape(n) + "</li>\n";
-  }
+  for (const std::string& n : notes) items += "<li class=\"note\">" + HtmlEscape(n) + "</li>\n";
   return s + (items.empty() ? "<p class=\"note\">Nothing: every figure was made.</p>\n" : "<ul>\n" + items + "</ul>\n");
 }
 
 }  // namespace
 
-std::string ReportHtml(const std::vector<RunData>& runs, const std::vector<Figure>& figures,
-                       const std::vector<std::string>& left_out) {
-  std::string title = "navtwin report:";
-  for (const RunData& r : runs) title += " " + r.label;
-  std::string s = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" + HtmlEscape(title) +
-                  "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" + HtmlEscape(title) + "</h1>\n" +
-                  "<p class=\"note\">Filter, RTS smoother and batch smoother of each run folder compared with "
-                  "each other and with the reference; made by <code>navtwin report</code> from the folders' "
-                  "summary.json and CSV files.</p>\n";
-  s += Contents(figures) + InputsSection(runs) + WarningsSection(runs);
-  s += "<h2 id=\"tables\">Summary tables</h2>\n" + ErrorsTable(runs) + ConsistencyTable(runs) + ResidualsTable(runs) +
-       ParametersTable(runs) + AdaptedNoiseList(runs);
+std::string HtmlPage(const PageText& text, const std::vector<Figure>& figures, const std::vector<std::string>& left_out) {
+  std::string s = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
+                  HtmlEscape(text.title) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
+                  HtmlEscape(text.title) + "</h1>\n<p class=\"note\">" + text.intro + "</p>\n";
+  s += Contents(text.sections, figures) + text.body;
   s += "<h2 id=\"figures\">Figures</h2>\n";
   for (const Figure& f : figures) s += FigureHtml(f);
-  s += LeftOutSection(runs, left_out);
+  s += LeftOutSection(left_out, text.notes);
   return s + kScript + "\n</body>\n</html>\n";
+}
+
+std::string ReportHtml(const std::vector<RunData>& runs, const std::vector<Figure>& figures,
+                       const std::vector<std::string>& left_out) {
+  PageText text;
+  text.title = "navtwin report:";
+  for (const RunData& r : runs) text.title += " " + r.label;
+  text.intro = "Filter, RTS smoother and batch smoother of each run folder compared with each other and with the "
+               "reference; made by <code>navtwin report</code> from the folders' summary.json and CSV files.";
+  text.sections = {{"inputs", "Runs"}, {"warnings", "Warnings"}, {"tables", "Summary tables"}};
+  text.body = InputsSection(runs) + WarningsSection(runs) + "<h2 id=\"tables\">Summary tables</h2>\n" +
+              ErrorsTable(runs) + ConsistencyTable(runs) + ResidualsTable(runs) + ParametersTable(runs) +
+              AdaptedNoiseList(runs);
+  for (const RunData& r : runs) text.notes.insert(text.notes.end(), r.notes.begin(), r.notes.end());
+  return HtmlPage(text, figures, left_out);
 }
 
 }  // namespace navtwin::report

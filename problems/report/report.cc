@@ -5,6 +5,8 @@
 #include <stdexcept>
 
 #include "core/io/atomic_file.h"
+#include "core/io/input_error.h"
+#include "problems/report/alignment_pages.h"
 #include "problems/report/figures.h"
 #include "problems/report/html.h"
 #include "problems/report/run_folder.h"
@@ -33,16 +35,73 @@ std::vector<std::string> Labels(const std::vector<std::string>& dirs) {
   return out;
 }
 
+/// The kind of page a summary.json asks for: its "command", with navigate and smooth (and
+/// folders written before the key existed) the GNSS/INS page.
+std::string PageKind(const AlignmentFolder& f) {
+  const YAML::Node c = JsonChild(f.summary, "command");
+  const std::string command = c && c.IsScalar() ? c.Scalar() : "";
+  if (command.empty() || command == "navigate" || command == "smooth") return "gnss-ins";
+  if (command == "transfer-align" || command == "inflight-align") return command;
+  throw InputError(f.summary_path, c.Mark().line >= 0 ? c.Mark().line + 1 : 0, "command",
+                   "'" + command + "' is not a command whose folder the report reads (navigate, smooth, "
+                   "transfer-align, inflight-align)");
+}
+
+/// The folders' summary.json and the one kind of page they share; InputError naming the
+/// folders when their commands differ.
+std::vector<AlignmentFolder> ReadFolders(const std::vector<std::string>& dirs, std::string* kind) {
+  const std::vector<std::string> labels = Labels(dirs);
+  std::vector<AlignmentFolder> folders;
+  std::string kinds;
+  for (std::size_t i = 0; i < dirs.size(); ++i) {
+    const std::string path = dirs[i] + "/summary.json";
+    folders.push_back({dirs[i], labels[i], path, ReadSummaryJson(dirs[i], path)});
+    const std::string k = PageKind(folders.back());
+    kinds += (i ? ", " : "") + dirs[i] + " (" + k + ")";
+    if (i == 0) *kind = k;
+    if (k != *kind) {
+      throw InputError(path, 0, "command", "the folders come from different commands and cannot share a page: " +
+                                               kinds + "; make one report per command");
+    }
+  }
+  return folders;
+}
+
+/// The page of transfer-align or inflight-align folders.
+ReportSummary WriteAlignmentReport(const ReportOptions& options, const std::vector<AlignmentFolder>& folders,
+                                   const std::string& kind) {
+  PageParts page = kind == "transfer-align" ? TransferPage(folders, options.max_points)
+                                            : InflightPage(folders, options.max_points);
+  if (options.progress) {
+    *options.progress << "report: drawing " << page.figures.figures.size() << " figures with gnuplot\n";
+  }
+  RenderFigures(&page.figures.figures, options.jobs);
+  AtomicFile out(options.out_path);
+  out.stream() << HtmlPage(page.text, page.figures.figures, page.figures.left_out);
+  out.Commit();
+  ReportSummary summary;
+  summary.figures = page.figures.figures.size();
+  summary.left_out = page.figures.left_out;
+  summary.left_out.insert(summary.left_out.end(), page.text.notes.begin(), page.text.notes.end());
+  return summary;
+}
+
 }  // namespace
 
 ReportSummary WriteReport(const ReportOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (options.run_dirs.empty()) throw std::invalid_argument("report: no run folder given");
-  const std::vector<std::string> labels = Labels(options.run_dirs);
+  std::string kind;
+  const std::vector<AlignmentFolder> folders = ReadFolders(options.run_dirs, &kind);
+  if (kind != "gnss-ins") {
+    ReportSummary summary = WriteAlignmentReport(options, folders, kind);
+    summary.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  }
   std::vector<RunData> runs;
   for (std::size_t i = 0; i < options.run_dirs.size(); ++i) {
     if (options.progress) *options.progress << "report: reading " << options.run_dirs[i] << "\n";
-    runs.push_back(LoadRunFolder(options.run_dirs[i], labels[i], options.run_dirs.size() > 1, options.max_points,
+    runs.push_back(LoadRunFolder(options.run_dirs[i], folders[i].label, options.run_dirs.size() > 1, options.max_points,
                                  options.jobs));
   }
   const auto elapsed_s = [&start] {

@@ -25,9 +25,13 @@ bool IsFile(const std::string& path) {
 
 long MarkLine(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
 
+}  // namespace
+
 YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path) {
   if (!IsFile(path)) {
-    throw InputError(path, 0, "", "no summary.json in " + dir + " (not the output folder of navtwin navigate or smooth)");
+    throw InputError(path, 0, "", "no summary.json in " + dir +
+                                      " (not the output folder of navtwin navigate, smooth, transfer-align or "
+                                      "inflight-align)");
   }
   YAML::Node root;
   try {
@@ -41,6 +45,8 @@ YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path) {
   }
   return root;
 }
+
+namespace {
 
 std::vector<Outage> ReadOutages(const YAML::Node& summary, const std::string& path) {
   std::vector<Outage> out;

@@ -89,6 +89,10 @@ struct RunData {
 RunData LoadRunFolder(const std::string& dir, const std::string& label, bool label_methods,
                       std::size_t max_points, int jobs);
 
+/// summary.json of the folder `dir` (at `path`): an object with a non-empty "methods"
+/// object. Throws InputError (file, line, field) when it is missing or malformed.
+YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path);
+
 /// A number of summary.json: NaN for null or absent; InputError naming the file, line and
 /// key for anything else that is not a number.
 double JsonNumber(const YAML::Node& node, const std::string& path, const std::string& key);

@@ -1,0 +1,220 @@
+// The report of the alignment commands' run folders (problems/report/alignment_pages.h):
+// hand-made transfer-align and inflight-align folders of two methods each (the layout of
+// docs/run-folder.md); the figures (valid SVG, the exact number of plotted series), several
+// folders overlaid, mixed commands refused, bad input (file, line, field; no page), and the
+// transfer page in a browser.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/io/input_error.h"
+#include "problems/report/report.h"
+#include "tests/report_page_check.h"
+#include "tests/scratch_dir.h"
+#include "tests/test_data.h"
+
+namespace navtwin::alignment_report_test {
+namespace {
+
+namespace check = report_page_check;
+
+std::string TransferMethodJson(const std::string& method) {
+  return "\"" + method + "\":{\"method\":\"" + method +
+         "\",\"roll_rms_mrad\":0.5,\"pitch_rms_mrad\":0.4,\"heading_rms_mrad\":0.9,\"roll_max_mrad\":1.5,"
+         "\"pitch_max_mrad\":1.2,\"heading_max_mrad\":2.5,\"delay_est_s\":0.2995,\"delay_sigma_s\":0.0002,"
+         "\"misalignment_deg\":[0.501,-0.299,0.802],\"run_time_s\":0.4,\"delay_true_s\":0.3,"
+         "\"misalignment_sigma_mrad\":[0.04,0.04,0.03],\"misalignment_true_deg\":[0.5,-0.3,0.8],"
+         "\"misalignment_error_mrad\":0.04,\"epochs\":201,\"note\":\"scored against the slave truth\"}";
+}
+
+/// estimates.csv: the misalignment converging from 0 to its true value, σ shrinking.
+std::string EstimatesCsv() {
+  std::ostringstream s;
+  s << "t_s,mis_roll_deg,mis_pitch_deg,mis_yaw_deg,mis_roll_std_mrad,mis_pitch_std_mrad,mis_yaw_std_mrad,delay_s,"
+       "delay_std_s\n";
+  for (int k = 0; k <= 200; ++k) {
+    const double c = 1.0 - std::exp(-0.05 * k), sigma = 20.0 * std::exp(-0.05 * k) + 0.04;
+    s << 0.1 * k << "," << 0.5 * c << "," << -0.3 * c << "," << 0.8 * c << "," << sigma << "," << sigma << ","
+      << sigma << "," << 0.3 * c << "," << 1e-3 * sigma << "\n";
+  }
+  return s.str();
+}
+
+std::string AttitudeErrorsCsv() {
+  std::ostringstream s;
+  s << "t_s,roll_err_mrad,pitch_err_mrad,heading_err_mrad\n";
+  for (int k = 0; k <= 200; ++k) s << 0.1 * k << "," << std::sin(0.1 * k) << ",0.5," << -std::cos(0.1 * k) << "\n";
+  return s.str();
+}
+
+std::string InflightMethodJson(const std::string& method) {
+  return "\"" + method + "\":{\"method\":\"" + method +
+         "\",\"heading_error_arcmin_at_km\":{\"10\":-2.0,\"20\":-1.5,\"50\":-1.0,\"100\":0.5},"
+         "\"final_heading_error_arcmin\":0.4,\"heading_sigma_arcmin\":0.45,\"run_time_s\":0.1,"
+         "\"heading_sigma_arcmin_at_km\":{\"10\":3.0,\"20\":1.5,\"50\":1.1,\"100\":0.5},\"path_length_km\":120,"
+         "\"gps_sigma_m\":17.4,\"fixes\":121,\"note\":\"0 of 121 GPS fixes rejected\"}";
+}
+
+std::string TrackCsv() {
+  std::ostringstream s;
+  s << "t_s,path_length_km,yaw_deg,sigma_arcmin,error_arcmin\n";
+  for (int k = 0; k <= 120; ++k) {
+    const double sigma = 30.0 / std::sqrt(1.0 + k);
+    s << k << "," << k << ",180," << sigma << "," << 0.5 * sigma * std::sin(0.3 * k) << "\n";
+  }
+  return s.str();
+}
+
+class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
+ protected:
+  std::string TransferFolder(const std::string& name) {
+    for (const char* m : {"order1", "batch"}) {
+      std::filesystem::create_directories(dir_ + "/" + name + "/" + m);
+      Write(name + "/" + m + "/estimates.csv", EstimatesCsv());
+      Write(name + "/" + m + "/attitude_errors.csv", AttitudeErrorsCsv());
+    }
+    Write(name + "/summary.json", "{\"command\":\"transfer-align\",\"methods\":{" + TransferMethodJson("order1") +
+                                      "," + TransferMethodJson("batch") + "}}\n");
+    return dir_ + "/" + name;
+  }
+  std::string InflightFolder(const std::string& name) {
+    for (const char* m : {"distance", "kalman"}) {
+      std::filesystem::create_directories(dir_ + "/" + name + "/" + m);
+      Write(name + "/" + m + "/track.csv", TrackCsv());
+    }
+    Write(name + "/summary.json", "{\"command\":\"inflight-align\",\"methods\":{" + InflightMethodJson("distance") +
+                                      "," + InflightMethodJson("kalman") + "}}\n");
+    return dir_ + "/" + name;
+  }
+  std::string Report(const std::vector<std::string>& dirs) {
+    report::ReportOptions o;
+    o.run_dirs = dirs;
+    o.out_path = dir_ + "/report.html";
+    o.max_points = 100;
+    report::WriteReport(o);
+    std::ifstream in(o.out_path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+};
+
+/// Every figure of the page is an SVG that draws exactly `expected` series (gnuplot's own
+/// groups and the page's data-series attribute).
+void ExpectFigures(const std::string& html, const std::map<std::string, int>& expected) {
+  const std::vector<check::PageFigure> figures = check::Figures(html);
+  ASSERT_EQ(figures.size(), expected.size());
+  for (const check::PageFigure& f : figures) {
+    SCOPED_TRACE(f.id);
+    ASSERT_EQ(expected.count(f.id), 1u);
+    EXPECT_EQ(f.mime, "image/svg+xml");
+    int w = 0, h = 0;
+    check::SvgSize(f.bytes, &w, &h);
+    EXPECT_GE(w, 800);
+    EXPECT_GE(h, 400);
+    EXPECT_EQ(check::PlottedSeries(f.bytes), expected.at(f.id));
+    EXPECT_EQ(f.series, expected.at(f.id));
+  }
+}
+
+TEST_F(AlignmentReportTest, TransferFiguresAndTables) {
+  const std::string html = Report({TransferFolder("ta")});
+  ExpectFigures(html, {{"misalignment", 15},  // 3 panels x (2 methods x (band + estimate) + the truth)
+                       {"delay", 5},         // 2 methods x (band + estimate) + the truth
+                       {"slave_attitude_errors", 6}});  // 3 panels x 2 methods
+  for (const char* text : {"0.5010 ± 0.04", "299.500 ± 0.2", "0.5000, -0.3000, 0.8000", "heading RMS",
+                           "scored against the slave truth"}) {
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  }
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+}
+
+TEST_F(AlignmentReportTest, InflightFiguresAndTables) {
+  const std::string html = Report({InflightFolder("ia")});
+  ExpectFigures(html, {{"heading_error", 4},    // 2 methods x (band + error)
+                       {"heading_sigma", 2}});  // 2 methods
+  for (const char* text : {"100 km", "-2.000", "<td>0.45</td>", "0 of 121 GPS fixes rejected"}) {
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  }
+}
+
+// Two folders of the same command overlay, labelled folder/method; the truth once per folder.
+TEST_F(AlignmentReportTest, SeveralFoldersOverlay) {
+  const std::string html = Report({TransferFolder("ta_a"), TransferFolder("ta_b")});
+  for (const check::PageFigure& f : check::Figures(html)) {
+    if (f.id != "misalignment") continue;
+    EXPECT_EQ(check::PlottedSeries(f.bytes), 30);  // 3 x (4 methods x 2 + 2 truths)
+    for (const char* label : {"ta_a/order1", "ta_b/batch", "ta_b: true"}) {
+      EXPECT_NE(f.bytes.find(label), std::string::npos) << label;
+    }
+  }
+  const std::string ia = Report({InflightFolder("ia_a"), InflightFolder("ia_b")});
+  EXPECT_NE(ia.find("ia_b/kalman"), std::string::npos);
+}
+
+/// The InputError of the report of `dirs`, and that no page was written.
+std::string ReportError(const std::vector<std::string>& dirs, const std::string& out) {
+  report::ReportOptions o;
+  o.run_dirs = dirs;
+  o.out_path = out;
+  try {
+    report::WriteReport(o);
+  } catch (const InputError& e) {
+    EXPECT_FALSE(navtwin::testing::FileExists(out)) << "partial report written";
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return "";
+}
+
+TEST_F(AlignmentReportTest, MixedCommandsAreRefusedNamingTheFolders) {
+  const std::string e = ReportError({TransferFolder("ta"), InflightFolder("ia")}, dir_ + "/mixed.html");
+  for (const char* part : {"/ta (transfer-align)", "/ia (inflight-align)", "different commands"}) {
+    EXPECT_NE(e.find(part), std::string::npos) << e;
+  }
+}
+
+TEST_F(AlignmentReportTest, BadInputNamesFileLineAndFieldAndWritesNoPage) {
+  const std::string out = dir_ + "/bad.html";
+  const std::string ta = TransferFolder("ta");
+  std::filesystem::remove(ta + "/batch/estimates.csv");
+  const std::string missing = ReportError({ta}, out);
+  EXPECT_NE(missing.find("batch/estimates.csv"), std::string::npos) << missing;
+
+  std::string csv = EstimatesCsv();
+  std::size_t at = 0;
+  for (int line = 1; line < 5; ++line) at = csv.find('\n', at) + 1;  // start of line 5
+  at = csv.find(',', csv.find(',', at) + 1) + 1;                    // the third field: mis_pitch_deg
+  csv.replace(at, 0, "x");
+  Write("ta/batch/estimates.csv", csv);
+  const std::string malformed = ReportError({ta}, out);
+  for (const char* part : {"batch/estimates.csv", "line 5", "mis_pitch_deg"}) {
+    EXPECT_NE(malformed.find(part), std::string::npos) << malformed;
+  }
+  const std::string ia = InflightFolder("ia");
+  std::filesystem::remove(ia + "/kalman/track.csv");
+  EXPECT_NE(ReportError({ia}, out).find("kalman/track.csv"), std::string::npos);
+}
+
+// The transfer page in a real browser: every figure loaded. Fails without chromium in CI.
+TEST_F(AlignmentReportTest, ChromiumLoadsEveryTransferFigure) {
+  const std::string chromium = check::ChromiumProgram();
+  if (chromium.empty()) {
+    if (navtwin::testing::InCi()) FAIL() << "chromium is missing in CI (.ci/setup installs it)";
+    GTEST_SKIP() << "chromium not installed";
+  }
+  const std::string html = Report({TransferFolder("ta")});
+  ASSERT_EQ(check::Figures(html).size(), 3u);
+  const std::string dom = check::DumpDom(chromium, dir_ + "/report.html", dir_);
+  ASSERT_FALSE(dom.empty()) << "chromium failed";
+  EXPECT_NE(dom.find("data-figures-loaded=\"3/3\""), std::string::npos) << dom.substr(0, 400);
+  EXPECT_EQ(dom.find("class=\"broken\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace navtwin::alignment_report_test
