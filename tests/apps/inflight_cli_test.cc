@@ -87,14 +87,22 @@ TEST(InflightCliTest, FilesWithTruthWriteTheTrack) {
 }
 
 // --out DIR: summary.json with every method, and each method's track (the same rows as
-// --track_csv writes).
+// --track_csv writes); --report adds the page.
 TEST(InflightCliTest, OutWritesTheRunFolder) {
   const std::string d = SimulatedDir();
   const std::string out = MakeTempDir("inflight_run") + "/run";
   const RunResult r = Navtwin("inflight-align --imu " + d + "/imu.txt --gnss " + d + "/gnss.txt --baro " + d +
                               "/baro.csv --init_from " + d + "/init.nav --truth " + d +
-                              "/truth.nav --method all --out " + out);
+                              "/truth.nav --method all --out " + out + " --report");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // --report: the page with its two figures (heading error and sigma against distance).
+  const std::string page = ReadAll(out + "/report.html");
+  std::size_t figures = 0;
+  for (std::size_t at = page.find("data:image/svg+xml;base64,"); at != std::string::npos;
+       at = page.find("data:image/svg+xml;base64,", at + 1)) {
+    ++figures;
+  }
+  EXPECT_EQ(figures, 2u);
   const std::string summary = ReadAll(out + "/summary.json");
   EXPECT_EQ(summary.rfind("{\"command\":\"inflight-align\",\"methods\":{\"distance\":{", 0), 0u) << summary;
   for (const char* method : {"distance", "kalman", "batch"}) {

@@ -111,13 +111,25 @@ std::size_t DataRows(const std::string& text, std::string* header) {
 
 // --out DIR: summary.json with the three methods, per method the estimates against time
 // (a row per update for the filters, per state for the batch, whose one estimate every row
-// repeats) and the attitude errors, with the same last estimate as summary.json.
+// repeats) and the attitude errors, with the same last estimate as summary.json; --report
+// adds the page (and needs --out).
 TEST(TransferCliTest, OutWritesTheRunFolder) {
   const std::string d = Folder();
   const std::string out = MakeTempDir("transfer_run") + "/run";
   const RunResult r = Navtwin("transfer-align --scenario " + d + "/short.yaml --seed 1 --config " + d +
-                              "/settle.yaml --method all --format=json --out " + out);
+                              "/settle.yaml --method all --format=json --out " + out + " --report");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // --report: the page of the folder, its three figures (misalignment, delay, attitude
+  // errors) embedded.
+  const std::string page = ReadAll(out + "/report.html");
+  std::size_t figures = 0;
+  for (std::size_t at = page.find("data:image/svg+xml;base64,"); at != std::string::npos;
+       at = page.find("data:image/svg+xml;base64,", at + 1)) {
+    ++figures;
+  }
+  EXPECT_EQ(figures, 3u);
+  const RunResult no_out = Navtwin("transfer-align --scenario " + d + "/short.yaml --method order1 --report");
+  EXPECT_EQ(no_out.exit_code, 2) << no_out.err;
   const std::string summary = ReadAll(out + "/summary.json");
   EXPECT_EQ(summary.rfind("{\"command\":\"transfer-align\",\"methods\":{\"order1\":{\"method\":\"order1\"", 0), 0u)
       << summary;
