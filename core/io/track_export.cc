@@ -1,7 +1,6 @@
 #include "core/io/track_export.h"
 
 #include <cmath>
-#include <cstdarg>
 #include <cstdio>
 #include <ctime>
 #include <stdexcept>
@@ -10,6 +9,7 @@
 #include "core/gps_time.h"
 #include "core/io/csv_series.h"
 #include "core/io/input_error.h"
+#include "core/text.h"
 #include "core/units.h"
 
 namespace navtwin {
@@ -21,32 +21,6 @@ constexpr double kStdMatch_s = 1e-6;
 /// Points of a sigma ellipse's polygon (10 degrees apart).
 constexpr int kEllipsePoints = 36;
 
-std::string ExportText(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
-std::string ExportText(const char* fmt, ...) {
-  char buffer[512];
-  va_list args;
-  va_start(args, fmt);
-  std::vsnprintf(buffer, sizeof buffer, fmt, args);
-  va_end(args);
-  return buffer;
-}
-
-/// Text for an XML element or attribute.
-std::string XmlEscaped(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 /// Week and seconds of week with 0 <= sow < 604800 (a reader's t_s may run past the week).
 void NormalizeGpsWeek(int* week, double* sow_s) {
   const double extra = std::floor(*sow_s / kExportWeek_s);
@@ -56,7 +30,7 @@ void NormalizeGpsWeek(int* week, double* sow_s) {
 
 void RequirePositiveSigma(const Eigen::Vector3d& std, const char* what, double t_s) {
   if (!(std.array() > 0.0).all() || !std.allFinite()) {
-    throw std::invalid_argument(ExportText("the %s sigma at t = %.6f s is not positive and finite", what, t_s));
+    throw std::invalid_argument(StringPrintf("the %s sigma at t = %.6f s is not positive and finite", what, t_s));
   }
 }
 
@@ -119,7 +93,7 @@ std::string UtcIsoTimeFromGps(int gps_week, double sow_s) {
   const std::time_t t = static_cast<std::time_t>(utc_s);
   std::tm tm{};
   if (gmtime_r(&t, &tm) == nullptr) throw std::invalid_argument("UtcIsoTimeFromGps: time out of range");
-  return ExportText("%04d-%02d-%02dT%02d:%02d:%02d.%03ldZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
+  return StringPrintf("%04d-%02d-%02dT%02d:%02d:%02d.%03ldZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
                 tm.tm_min, tm.tm_sec, ms);
 }
 
@@ -140,14 +114,14 @@ RtklibPosWriter::RtklibPosWriter(const std::string& path, const std::string& sou
 void RtklibPosWriter::Write(const NavState& s, const Eigen::Vector3d& pos_std_ned_m,
                             const Eigen::Vector3d& vel_std_ned_mps) {
   if (s.gps_week < 0) {
-    throw std::invalid_argument(ExportText("the epoch at t = %.6f s has no GPS week: RTKLIB .pos needs GPS time", s.t_s));
+    throw std::invalid_argument(StringPrintf("the epoch at t = %.6f s has no GPS week: RTKLIB .pos needs GPS time", s.t_s));
   }
   RequirePositiveSigma(pos_std_ned_m, "position", s.t_s);
   RequirePositiveSigma(vel_std_ned_mps, "velocity", s.t_s);
   int week = s.gps_week;
   double sow = s.t_s;
   NormalizeGpsWeek(&week, &sow);
-  file_.stream() << ExportText(
+  file_.stream() << StringPrintf(
       "%4d %11.4f %14.9f %14.9f %10.4f %3d %3d %8.4f %8.4f %8.4f %8.4f %8.4f %8.4f %6.2f %6.1f %8.5f %8.5f %8.5f "
       "%8.5f %8.5f %8.5f %8.5f %8.5f %8.5f\n",
       week, sow, s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m, 5, 0, pos_std_ned_m.x(), pos_std_ned_m.y(),
@@ -171,12 +145,12 @@ KmlWriter::KmlWriter(const std::string& path, const std::string& name, double el
   }
   std::ostream& o = file_.stream();
   o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-    << "<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document>\n<name>" << XmlEscaped(name) << "</name>\n"
+    << "<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document>\n<name>" << MarkupEscaped(name) << "</name>\n"
     << "<Style id=\"track\"><LineStyle><color>ff0000ff</color><width>2</width></LineStyle></Style>\n"
     << "<Style id=\"ellipse\"><LineStyle><color>ff00ffff</color><width>1</width></LineStyle>"
        "<PolyStyle><fill>0</fill></PolyStyle></Style>\n";
   if (ellipse_sigma_ > 0.0) {
-    o << "<Folder><name>" << ExportText("%g", ellipse_sigma_) << "-sigma horizontal position ellipses</name>\n";
+    o << "<Folder><name>" << StringPrintf("%g", ellipse_sigma_) << "-sigma horizontal position ellipses</name>\n";
   }
 }
 
@@ -190,7 +164,7 @@ void KmlWriter::WriteEllipse(const NavState& s, const Eigen::Vector3d& pos_std_n
     const double a = 2.0 * kPi * static_cast<double>(k % kEllipsePoints) / kEllipsePoints;
     const double dn_m = ellipse_sigma_ * pos_std_ned_m.x() * std::cos(a);
     const double de_m = ellipse_sigma_ * pos_std_ned_m.y() * std::sin(a);
-    o << ExportText("%.9f,%.9f,0 ", (s.lon_rad + de_m / r_e) * kRadToDeg, (s.lat_rad + dn_m / r_n) * kRadToDeg);
+    o << StringPrintf("%.9f,%.9f,0 ", (s.lon_rad + de_m / r_e) * kRadToDeg, (s.lat_rad + dn_m / r_n) * kRadToDeg);
   }
   o << "</coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark>\n";
   ++ellipses_;
@@ -207,9 +181,9 @@ void KmlWriter::Write(const NavState& s, const Eigen::Vector3d* pos_std_ned_m) {
 void KmlWriter::Commit() {
   std::ostream& o = file_.stream();
   if (ellipse_sigma_ > 0.0) o << "</Folder>\n";
-  o << "<Placemark><name>" << XmlEscaped(name_) << "</name><styleUrl>#track</styleUrl><LineString>"
+  o << "<Placemark><name>" << MarkupEscaped(name_) << "</name><styleUrl>#track</styleUrl><LineString>"
     << "<tessellate>1</tessellate><altitudeMode>clampToGround</altitudeMode><coordinates>\n";
-  for (const Eigen::Vector2d& p : track_lon_lat_deg_) o << ExportText("%.9f,%.9f,0\n", p.x(), p.y());
+  for (const Eigen::Vector2d& p : track_lon_lat_deg_) o << StringPrintf("%.9f,%.9f,0\n", p.x(), p.y());
   o << "</coordinates></LineString></Placemark>\n</Document>\n</kml>\n";
   file_.Commit();
 }
@@ -219,12 +193,12 @@ void KmlWriter::Commit() {
 GpxWriter::GpxWriter(const std::string& path, const std::string& name) : file_(path) {
   file_.stream() << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                  << "<gpx version=\"1.1\" creator=\"navtwin\" xmlns=\"http://www.topografix.com/GPX/1/1\">\n"
-                 << "<trk><name>" << XmlEscaped(name) << "</name><trkseg>\n";
+                 << "<trk><name>" << MarkupEscaped(name) << "</name><trkseg>\n";
 }
 
 void GpxWriter::Write(const NavState& s) {
   std::ostream& o = file_.stream();
-  o << ExportText("<trkpt lat=\"%.9f\" lon=\"%.9f\"><ele>%.4f</ele>", s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg,
+  o << StringPrintf("<trkpt lat=\"%.9f\" lon=\"%.9f\"><ele>%.4f</ele>", s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg,
               s.h_m);
   if (s.gps_week >= 0) o << "<time>" << UtcIsoTimeFromGps(s.gps_week, s.t_s) << "</time>";
   o << "</trkpt>\n";

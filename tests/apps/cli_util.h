@@ -50,6 +50,13 @@ inline RunResult Navtwin(const std::string& args) {
   return r;
 }
 
+/// How often `what` occurs in `text` (non-overlapping starts counted one by one).
+inline std::size_t Occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
 inline bool Exists(const std::string& path) {
   struct stat st;
   return ::stat(path.c_str(), &st) == 0;

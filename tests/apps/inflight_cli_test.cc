@@ -96,13 +96,7 @@ TEST(InflightCliTest, OutWritesTheRunFolder) {
                               "/truth.nav --method all --out " + out + " --report");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // --report: the page with its two figures (heading error and sigma against distance).
-  const std::string page = ReadAll(out + "/report.html");
-  std::size_t figures = 0;
-  for (std::size_t at = page.find("data:image/svg+xml;base64,"); at != std::string::npos;
-       at = page.find("data:image/svg+xml;base64,", at + 1)) {
-    ++figures;
-  }
-  EXPECT_EQ(figures, 2u);
+  EXPECT_EQ(Occurrences(ReadAll(out + "/report.html"), "data:image/svg+xml;base64,"), 2u);
   const std::string summary = ReadAll(out + "/summary.json");
   EXPECT_EQ(summary.rfind("{\"command\":\"inflight-align\",\"methods\":{\"distance\":{", 0), 0u) << summary;
   for (const char* method : {"distance", "kalman", "batch"}) {

@@ -121,13 +121,7 @@ TEST(TransferCliTest, OutWritesTheRunFolder) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // --report: the page of the folder, its three figures (misalignment, delay, attitude
   // errors) embedded.
-  const std::string page = ReadAll(out + "/report.html");
-  std::size_t figures = 0;
-  for (std::size_t at = page.find("data:image/svg+xml;base64,"); at != std::string::npos;
-       at = page.find("data:image/svg+xml;base64,", at + 1)) {
-    ++figures;
-  }
-  EXPECT_EQ(figures, 3u);
+  EXPECT_EQ(Occurrences(ReadAll(out + "/report.html"), "data:image/svg+xml;base64,"), 3u);
   const RunResult no_out = Navtwin("transfer-align --scenario " + d + "/short.yaml --method order1 --report");
   EXPECT_EQ(no_out.exit_code, 2) << no_out.err;
   const std::string summary = ReadAll(out + "/summary.json");
