@@ -203,6 +203,7 @@ int RunLevelMc(const std::vector<std::string>& args) {
   c.true_pitch_deg = FLAGS_true_pitch_deg;
   c.seed = FLAGS_seed;
   if (FLAGS_threads < 0) return Usage("--threads must be 0 (all cores) or positive");
+  if (FLAGS_report && FLAGS_out.empty()) return Usage("--report needs --out DIR (it writes DIR/report.html)");
   c.threads = FLAGS_threads;
   const std::string invalid = leveling::ValidateMonteCarloConfig(c);
   if (!invalid.empty()) return Usage(invalid);
@@ -215,6 +216,7 @@ int RunLevelMc(const std::vector<std::string>& args) {
   const MonteCarloResult result = leveling::RunLevelingMonteCarlo(c, options, run_options);
   if (!FLAGS_errors_csv.empty()) WriteErrorsCsv(FLAGS_errors_csv, result);
   if (!FLAGS_out.empty()) WriteRunFolder(result);
+  if (!FLAGS_out.empty() && FLAGS_report) WriteRunReport("level-mc", FLAGS_out);
   if (FLAGS_format == "json") {
     WriteResultJson(std::cout, result, false);
   } else {
@@ -230,10 +232,10 @@ Command LevelMcCommand() {
           "Monte Carlo of leveling under rotor vibration (seed 000): every method's roll/pitch errors",
           "navtwin level-mc [--runs N] [--rate_hz 600] [--window_s 0.2] [--vib_axes x|xyz|x,y,z] "
           "[--vib_freq_hz 22:24] [--vib_amp_g 1] [--vib_tones 1] [--noise_mg 50] [--true_roll_deg 0] "
-          "[--true_pitch_deg 0] [--seed S] [--threads 2] [--errors_csv FILE] [--out DIR] [--batch_covariance] "
+          "[--true_pitch_deg 0] [--seed S] [--threads 2] [--errors_csv FILE] [--out DIR [--report]] [--batch_covariance] "
           "[--format=json]",
           {"runs", "rate_hz", "window_s", "vib_axes", "vib_freq_hz", "vib_amp_g", "vib_tones", "noise_mg",
-           "true_roll_deg", "true_pitch_deg", "seed", "threads", "errors_csv", "out", "batch_covariance"},
+           "true_roll_deg", "true_pitch_deg", "seed", "threads", "errors_csv", "out", "report", "batch_covariance"},
           &RunLevelMc};
 }
 

@@ -1,6 +1,7 @@
 // The report pages of the alignment commands' run folders (docs/run-folder.md):
 //   transfer-align: summary.json, <method>/estimates.csv, <method>/attitude_errors.csv (with a truth)
 //   inflight-align: summary.json, <method>/track.csv
+//   level-mc: summary.json, errors.csv
 // Each builds the page's tables and its figures (scripts, not yet rendered); report.cc
 // renders them and writes the page (html.h HtmlPage).
 #pragma once
@@ -40,5 +41,10 @@ PageParts TransferPage(const std::vector<AlignmentFolder>& folders, std::size_t 
 /// end (tables), the heading error against the distance flown with ±3σ bands, σ against
 /// distance. Throws InputError for a method without track.csv or a malformed file.
 PageParts InflightPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points);
+
+/// level-mc folders: per method the errors' RMS and max, mean σ and err/σ (table), the
+/// histograms of the pitch and roll errors over the runs. Throws InputError for a folder
+/// without errors.csv, a method's column missing, or a malformed row.
+PageParts LevelingPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points);
 
 }  // namespace navtwin::report

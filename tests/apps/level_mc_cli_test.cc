@@ -75,11 +75,14 @@ TEST(LevelMcCliTest, ErrorsCsvHasOneRowPerRunMatchingTheJson) {
 }
 
 // --out DIR: the same errors.csv as --errors_csv, and summary.json the --format=json object
-// led by the command's name.
+// led by the command's name; --report adds the page (and needs --out).
 TEST(LevelMcCliTest, OutWritesTheRunFolder) {
   const std::string dir = MakeTempDir("level_mc_run") + "/run";
-  const RunResult r = Navtwin("level-mc --runs 25 --seed 9 --format=json --out " + dir);
+  const RunResult r = Navtwin("level-mc --runs 25 --seed 9 --format=json --out " + dir + " --report");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // --report: the page with its two histograms (pitch, roll).
+  EXPECT_EQ(Occurrences(ReadAll(dir + "/report.html"), "data:image/svg+xml;base64,"), 2u);
+  EXPECT_EQ(Navtwin("level-mc --runs 5 --report").exit_code, 2);
   const std::string summary = ReadAll(dir + "/summary.json");
   EXPECT_EQ(summary, "{\"command\":\"level-mc\"," + r.out.substr(1)) << summary;
   std::istringstream in(ReadAll(dir + "/errors.csv"));

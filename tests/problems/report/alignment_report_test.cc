@@ -91,6 +91,23 @@ class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
                                       "," + InflightMethodJson("kalman") + "}}\n");
     return dir_ + "/" + name;
   }
+  /// A level-mc folder of two methods over 400 runs: errors spread over +-0.1 / +-0.3 deg.
+  std::string LevelingFolder(const std::string& name) {
+    std::filesystem::create_directories(dir_ + "/" + name);
+    std::ostringstream csv;
+    csv << "run,plain_mean_pitch_deg,plain_mean_roll_deg,batch_pitch_deg,batch_roll_deg\n";
+    for (int k = 0; k < 400; ++k) {
+      const double u = std::sin(0.7 * k), v = std::cos(1.3 * k);
+      csv << k << "," << 0.3 * u << "," << 0.3 * v << "," << 0.1 * u << "," << 0.1 * v << "\n";
+    }
+    Write(name + "/errors.csv", csv.str());
+    const std::string stats = "\"pitch_rms_deg\":0.21,\"pitch_max_deg\":0.3,\"roll_rms_deg\":0.2,\"roll_max_deg\":0.3,"
+                              "\"pitch_sigma_mean_deg\":0.2,\"roll_sigma_mean_deg\":0.2,"
+                              "\"pitch_error_over_sigma_rms\":1.05,\"fallbacks\":0,\"cpu_time_s\":0.5";
+    Write(name + "/summary.json", "{\"command\":\"level-mc\",\"runs\":400,\"run_time_s\":1.0,\"methods\":{"
+                                  "\"plain_mean\":{" + stats + "},\"batch\":{" + stats + "}}}\n");
+    return dir_ + "/" + name;
+  }
   std::string Report(const std::vector<std::string>& dirs) {
     report::ReportOptions o;
     o.run_dirs = dirs;
@@ -214,6 +231,19 @@ TEST_F(AlignmentReportTest, ChromiumLoadsEveryTransferFigure) {
   ASSERT_FALSE(dom.empty()) << "chromium failed";
   EXPECT_NE(dom.find("data-figures-loaded=\"3/3\""), std::string::npos) << dom.substr(0, 400);
   EXPECT_EQ(dom.find("class=\"broken\""), std::string::npos);
+}
+
+// The leveling Monte Carlo: one histogram per angle with a series per method; a method of
+// summary.json whose columns errors.csv lacks is an InputError naming the column.
+TEST_F(AlignmentReportTest, LevelingHistograms) {
+  const std::string html = Report({LevelingFolder("lv")});
+  ExpectFigures(html, {{"pitch_histogram", 2}, {"roll_histogram", 2}});
+  for (const char* text : {"plain_mean", "pitch err/σ RMS", "<td>400</td>"}) {
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  }
+  Write("lv/errors.csv", "run,plain_mean_pitch_deg,plain_mean_roll_deg\n0,0.1,0.2\n");
+  const std::string e = ReportError({dir_ + "/lv"}, dir_ + "/lv_bad.html");
+  EXPECT_NE(e.find("batch_pitch_deg"), std::string::npos) << e;
 }
 
 }  // namespace

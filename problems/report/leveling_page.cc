@@ -1,0 +1,133 @@
+// The report page of level-mc run folders (alignment_pages.h).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "core/io/input_error.h"
+#include "problems/report/alignment_pages.h"
+#include "problems/report/csv_table.h"
+#include "problems/report/gnuplot.h"
+#include "problems/report/run_folder.h"
+
+namespace navtwin::report {
+namespace {
+
+/// Bins of the error histograms: enough to show a Gaussian's shape over a few thousand runs.
+constexpr int kHistogramBins = 60;
+
+/// One method of one level-mc folder: every run's pitch and roll error.
+struct LevelingMethod {
+  const AlignmentFolder* folder = nullptr;
+  std::string method;
+  std::string label;  ///< "method", or "folder/method" with several folders
+  std::string color;
+  std::vector<double> pitch_deg, roll_deg;
+};
+
+std::vector<LevelingMethod> LoadLevelingMethods(const std::vector<AlignmentFolder>& folders) {
+  std::vector<LevelingMethod> out;
+  for (const AlignmentFolder& f : folders) {
+    const std::string path = f.dir + "/errors.csv";
+    if (!std::filesystem::is_regular_file(path)) {
+      throw InputError(path, 0, "", "missing: a level-mc folder has every run's errors in errors.csv");
+    }
+    std::vector<std::string> names;
+    std::vector<CsvColumn> columns;
+    for (const auto& kv : f.summary["methods"]) {
+      names.push_back(kv.first.Scalar());
+      columns.push_back({names.back() + "_pitch_deg"});
+      columns.push_back({names.back() + "_roll_deg"});
+    }
+    const CsvTable csv(path, columns);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      LevelingMethod m;
+      m.folder = &f;
+      m.method = names[i];
+      m.label = folders.size() > 1 ? f.label + "/" + m.method : m.method;
+      m.color = SeriesColor(out.size());
+      m.pitch_deg = csv.number(2 * i);
+      m.roll_deg = csv.number(2 * i + 1);
+      out.push_back(std::move(m));
+    }
+  }
+  return out;
+}
+
+double LevelingNumber(const LevelingMethod& m, const std::string& key) {
+  const YAML::Node node = JsonChild(JsonChild(JsonChild(m.folder->summary, "methods"), m.method), key);
+  return JsonNumber(node, m.folder->summary_path, "methods." + m.method + "." + key);
+}
+
+std::string LevelingTable(const std::vector<LevelingMethod>& methods) {
+  const std::vector<std::pair<std::string, std::string>> columns = {
+      {"pitch_rms_deg", "pitch RMS [deg]"},        {"pitch_max_deg", "pitch max [deg]"},
+      {"roll_rms_deg", "roll RMS [deg]"},          {"roll_max_deg", "roll max [deg]"},
+      {"pitch_sigma_mean_deg", "mean σ pitch [deg]"}, {"roll_sigma_mean_deg", "mean σ roll [deg]"},
+      {"pitch_error_over_sigma_rms", "pitch err/σ RMS"}, {"fallbacks", "fallbacks"},
+      {"cpu_time_s", "CPU [s]"}};
+  std::vector<std::string> head = {"method", "runs"};
+  for (const auto& c : columns) head.push_back(c.second);
+  std::string s = "<h3>Errors over the runs (estimate − truth)</h3>\n<table>" + HtmlHead(head);
+  for (const LevelingMethod& m : methods) {
+    s += "<tr>" + HtmlNameCell(m.label) + HtmlCell(static_cast<double>(m.pitch_deg.size()), "%.0f");
+    for (const auto& c : columns) s += HtmlCell(LevelingNumber(m, c.first), "%.4g");
+    s += "</tr>\n";
+  }
+  return s + "</table>\n";
+}
+
+/// Overlaid step histograms of one error (pitch or roll) of every method, on common bins
+/// over [-L, L] with L the largest finite |error| of all methods.
+Figure HistogramFigure(const std::vector<LevelingMethod>& methods, bool pitch) {
+  const char* what = pitch ? "pitch" : "roll";
+  double limit = 0.0;
+  for (const LevelingMethod& m : methods) {
+    for (const double e : pitch ? m.pitch_deg : m.roll_deg) {
+      if (std::isfinite(e)) limit = std::max(limit, std::abs(e));
+    }
+  }
+  if (!(limit > 0.0)) limit = 1.0;
+  const double width = 2.0 * limit / kHistogramBins;
+  Figure f;
+  f.id = std::string(what) + "_histogram";
+  f.title = std::string("Histogram of the ") + what + " error";
+  f.script = GnuplotCommon() + "set ylabel 'runs per bin'\nset xlabel '" + what + " error [deg]'\n";
+  std::string plots;
+  for (std::size_t i = 0; i < methods.size(); ++i) {
+    std::vector<double> centres(kHistogramBins), counts(kHistogramBins, 0.0);
+    for (int b = 0; b < kHistogramBins; ++b) centres[b] = -limit + (b + 0.5) * width;
+    for (const double e : pitch ? methods[i].pitch_deg : methods[i].roll_deg) {
+      if (!std::isfinite(e)) continue;
+      counts[std::min(kHistogramBins - 1, static_cast<int>((e + limit) / width))] += 1.0;
+    }
+    const std::string name = std::string(what) + std::to_string(i);
+    AppendDatablock(&f.script, name, {centres, counts});
+    plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:2 w histeps lw 1.4 lc rgb '" +
+             methods[i].color + "' title " + GnuplotQuote(methods[i].label);
+    ++f.series;
+  }
+  f.script += "plot " + plots + "\n";
+  f.caption = std::string("The ") + what + " error of every run (errors.csv) per method, " +
+              std::to_string(kHistogramBins) + " common bins over ± the largest error; non-finite errors left out.";
+  return f;
+}
+
+}  // namespace
+
+PageParts LevelingPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points) {
+  (void)max_points;  // histograms use every run
+  PageParts page;
+  const std::vector<LevelingMethod> methods = LoadLevelingMethods(folders);
+  page.text.title = "navtwin report (leveling Monte Carlo):";
+  for (const AlignmentFolder& f : folders) page.text.title += " " + f.label;
+  page.text.intro = "Leveling under rotor vibration: every method's roll and pitch errors over the Monte Carlo runs; "
+                    "made by <code>navtwin report</code> from the folders' summary.json and errors.csv "
+                    "(<code>navtwin level-mc --out</code>).";
+  page.text.sections = {{"tables", "Summary tables"}};
+  page.text.body = "<h2 id=\"tables\">Summary tables</h2>\n" + LevelingTable(methods);
+  page.figures.figures.push_back(HistogramFigure(methods, true));
+  page.figures.figures.push_back(HistogramFigure(methods, false));
+  return page;
+}
+
+}  // namespace navtwin::report
