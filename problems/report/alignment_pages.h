@@ -31,6 +31,12 @@ struct PageParts {
   FigureSet figures;
 };
 
+/// The text frame of an alignment page: the title "navtwin report (<what>): <folders>", the
+/// intro paragraph (HTML), one "Summary tables" section whose body starts with its heading
+/// followed by `tables` (HTML).
+PageText AlignmentPageText(const std::vector<AlignmentFolder>& folders, const std::string& what,
+                           const std::string& intro, const std::string& tables);
+
 /// transfer-align folders: per method the attitude errors and the final estimates (tables),
 /// the misalignment and the delay against time with ±3σ bands and the true values, the
 /// slave's attitude errors. Throws InputError (file, line, field) for a method without

@@ -147,22 +147,21 @@ Figure InflightSigmaFigure(const std::vector<InflightMethod>& methods) {
 
 PageParts InflightPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points) {
   PageParts page;
-  const std::vector<InflightMethod> methods = LoadInflightMethods(folders, max_points, &page.text.notes);
-  page.text.title = "navtwin report (in-flight alignment):";
-  for (const AlignmentFolder& f : folders) page.text.title += " " + f.label;
-  page.text.intro = "In-flight heading alignment from the distance flown: the methods of each run folder compared "
-                    "with each other and with the truth; made by <code>navtwin report</code> from the folders' "
-                    "summary.json and CSV files (<code>navtwin inflight-align --out</code>).";
-  page.text.sections = {{"tables", "Summary tables"}};
-  page.text.body =
-      "<h2 id=\"tables\">Summary tables</h2>\n" +
+  std::vector<std::string> notes;
+  const std::vector<InflightMethod> methods = LoadInflightMethods(folders, max_points, &notes);
+  page.text = AlignmentPageText(
+      folders, "in-flight alignment",
+      "In-flight heading alignment from the distance flown: the methods of each run folder compared with each other "
+      "and with the truth; made by <code>navtwin report</code> from the folders' summary.json and CSV files "
+      "(<code>navtwin inflight-align --out</code>).",
       InflightTable(methods, "Heading error (estimate − truth) [arcmin] at the distance flown, and at the end",
                     "heading_error_arcmin_at_km",
                     {{"final_heading_error_arcmin", "final error"}, {"heading_sigma_arcmin", "final σ"},
                      {"path_length_km", "distance [km]"}, {"fixes", "GPS fixes"}, {"gps_sigma_m", "GPS σ [m]"},
                      {"run_time_s", "run [s]"}}) +
-      InflightTable(methods, "Heading σ [arcmin] at the distance flown", "heading_sigma_arcmin_at_km", {}) +
-      InflightNotes(methods);
+          InflightTable(methods, "Heading σ [arcmin] at the distance flown", "heading_sigma_arcmin_at_km", {}) +
+          InflightNotes(methods));
+  page.text.notes = notes;
   InflightErrorFigure(methods, &page.figures);
   page.figures.figures.push_back(InflightSigmaFigure(methods));
   return page;

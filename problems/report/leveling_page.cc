@@ -118,13 +118,12 @@ PageParts LevelingPage(const std::vector<AlignmentFolder>& folders, std::size_t 
   (void)max_points;  // histograms use every run
   PageParts page;
   const std::vector<LevelingMethod> methods = LoadLevelingMethods(folders);
-  page.text.title = "navtwin report (leveling Monte Carlo):";
-  for (const AlignmentFolder& f : folders) page.text.title += " " + f.label;
-  page.text.intro = "Leveling under rotor vibration: every method's roll and pitch errors over the Monte Carlo runs; "
-                    "made by <code>navtwin report</code> from the folders' summary.json and errors.csv "
-                    "(<code>navtwin level-mc --out</code>).";
-  page.text.sections = {{"tables", "Summary tables"}};
-  page.text.body = "<h2 id=\"tables\">Summary tables</h2>\n" + LevelingTable(methods);
+  page.text = AlignmentPageText(
+      folders, "leveling Monte Carlo",
+      "Leveling under rotor vibration: every method's roll and pitch errors over the Monte Carlo runs; made by "
+      "<code>navtwin report</code> from the folders' summary.json and errors.csv (<code>navtwin level-mc "
+      "--out</code>).",
+      LevelingTable(methods));
   page.figures.figures.push_back(HistogramFigure(methods, true));
   page.figures.figures.push_back(HistogramFigure(methods, false));
   return page;

@@ -89,6 +89,17 @@ ReportSummary WriteAlignmentReport(const ReportOptions& options, const std::vect
 
 }  // namespace
 
+PageText AlignmentPageText(const std::vector<AlignmentFolder>& folders, const std::string& what,
+                           const std::string& intro, const std::string& tables) {
+  PageText text;
+  text.title = "navtwin report (" + what + "):";
+  for (const AlignmentFolder& f : folders) text.title += " " + f.label;
+  text.intro = intro;
+  text.sections = {{"tables", "Summary tables"}};
+  text.body = "<h2 id=\"tables\">Summary tables</h2>\n" + tables;
+  return text;
+}
+
 ReportSummary WriteReport(const ReportOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (options.run_dirs.empty()) throw std::invalid_argument("report: no run folder given");

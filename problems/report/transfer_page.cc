@@ -248,15 +248,15 @@ void TransferAttitudeFigure(const std::vector<TransferMethod>& methods, FigureSe
 
 PageParts TransferPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points) {
   PageParts page;
-  const std::vector<TransferMethod> methods = LoadTransferMethods(folders, max_points, &page.text.notes);
-  page.text.title = "navtwin report (transfer alignment):";
-  for (const AlignmentFolder& f : folders) page.text.title += " " + f.label;
-  page.text.intro = "Transfer alignment of a slave IMU to a master INS: the methods of each run folder compared with "
-                    "each other and with the truth; made by <code>navtwin report</code> from the folders' "
-                    "summary.json and CSV files (<code>navtwin transfer-align --out</code>).";
-  page.text.sections = {{"tables", "Summary tables"}};
-  page.text.body = "<h2 id=\"tables\">Summary tables</h2>\n" + TransferAttitudeTable(methods) +
-                   TransferEstimatesTable(methods);
+  std::vector<std::string> notes;
+  const std::vector<TransferMethod> methods = LoadTransferMethods(folders, max_points, &notes);
+  page.text = AlignmentPageText(
+      folders, "transfer alignment",
+      "Transfer alignment of a slave IMU to a master INS: the methods of each run folder compared with each other "
+      "and with the truth; made by <code>navtwin report</code> from the folders' summary.json and CSV files "
+      "(<code>navtwin transfer-align --out</code>).",
+      TransferAttitudeTable(methods) + TransferEstimatesTable(methods));
+  page.text.notes = notes;
   page.figures.figures.push_back(TransferMisalignmentFigure(methods));
   page.figures.figures.push_back(TransferDelayFigure(methods));
   TransferAttitudeFigure(methods, &page.figures);
