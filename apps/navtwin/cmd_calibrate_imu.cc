@@ -13,6 +13,7 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
+#include "problems/calibration/calibration_run_folder.h"
 #include "problems/calibration/imu_calibration.h"
 
 DEFINE_string(rig, "", "calibrate-imu: multiposition, pendulum or temperature (what --data records)");
@@ -40,6 +41,7 @@ int RunCalibrateImu(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args.front() + "' (the record goes in --data)");
   if (FLAGS_data.empty()) return Usage("--data RECORD is required");
   if (FLAGS_format != "text" && FLAGS_format != "json") return Usage("--format must be text or json");
+  if (FLAGS_report && FLAGS_run_dir.empty()) return Usage("--report needs --run_dir DIR (it writes DIR/report.html)");
   calibration::ImuCalibrationResult result;
   if (FLAGS_rig == "multiposition") {
     result = calibration::CalibrateMultiPositionRecord(FLAGS_data);
@@ -52,12 +54,19 @@ int RunCalibrateImu(const std::vector<std::string>& args) {
   } else {
     return Usage("unknown --rig '" + FLAGS_rig + "': multiposition, pendulum or temperature");
   }
-  if (!FLAGS_out.empty()) {
-    CalibrationFile file;
-    file.created_by = CommandLine();
-    file.imu = result.calibration;
-    WriteCalibrationFile(FLAGS_out, file);
+  CalibrationFile file;
+  file.created_by = CommandLine();
+  file.imu = result.calibration;
+  if (!FLAGS_run_dir.empty()) {
+    calibration::WriteCalibrationRunFolder(
+        FLAGS_run_dir, calibration::ImuCalibrationJson(result, FLAGS_rig, "calibrate-imu"), file,
+        {{"parameters.csv", [&result](std::ostream& o) { calibration::WriteImuParametersCsv(o, result); }},
+         {"residuals.csv", [&result](std::ostream& o) { calibration::WriteImuResidualsCsv(o, result); }}});
+    std::cerr << "calibrate-imu: run folder " << FLAGS_run_dir
+              << " (summary.json, calibration.yaml, parameters.csv, residuals.csv)\n";
+    if (FLAGS_report) WriteRunReport("calibrate-imu", FLAGS_run_dir);
   }
+  if (!FLAGS_out.empty()) WriteCalibrationFile(FLAGS_out, file);
   if (FLAGS_format == "json") {
     std::cout << calibration::ImuCalibrationJson(result, FLAGS_rig) << "\n";
   } else {
@@ -73,7 +82,7 @@ Command CalibrateImuCommand() {
   return {"calibrate-imu",
           "IMU scale factor, misalignment, bias and g-sensitivity (with sigma) from a calibration record",
           "navtwin calibrate-imu --data RECORD --rig multiposition|pendulum|temperature [--out FILE] "
-          "[--format=json]\n"
+          "[--run_dir DIR [--report]] [--format=json]\n"
           "  RECORD is a YAML file naming the IMU files and what the rig did (docs/calibration-imu.md):\n"
           "  - multiposition: {imu, latitude_deg, height_m, trajectory: {kind: multiposition, ...}}, the\n"
           "    table schedule in the simulator's schema, on the IMU's time scale;\n"
@@ -83,10 +92,12 @@ Command CalibrateImuCommand() {
           "    one multi-position schedule per chamber temperature, or warm-up runs with\n"
           "    temperature: FILE (t_s,temperature_degC) instead (docs/calibration-temperature.md).\n"
           "  Prints every parameter with one sigma and the parameters the data cannot observe (held\n"
-          "  at 0); --out writes the calibration file that --calibration applies to IMU readers.\n"
+          "  at 0); --out writes the calibration file that --calibration applies to IMU readers; --run_dir\n"
+          "  the run folder (docs/run-folder.md: summary, calibration file, parameters, residuals before\n"
+          "  and after) and with --report its page (navtwin report DIR).\n"
           "  Exit 1 for records that cannot calibrate (too few positions, a temperature span too\n"
           "  small for the order, ...), with what is missing; nothing is written then.",
-          {"data", "rig", "out"},
+          {"data", "rig", "out", "run_dir", "report"},
           &RunCalibrateImu};
 }
 

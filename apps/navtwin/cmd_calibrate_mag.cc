@@ -27,6 +27,7 @@
 #include "core/io/json_writer.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
+#include "problems/calibration/calibration_run_folder.h"
 #include "problems/calibration/mag_calibration.h"
 #include "problems/calibration/mag_heading.h"
 
@@ -104,9 +105,13 @@ void PrintText(const MagCalibration& c, const HeadingErrors& h, const std::strin
               Fixed(h.before_deg, 3).c_str(), Fixed(h.after_deg, 3).c_str(), h.samples);
 }
 
-void PrintJson(const MagCalibration& c, const HeadingErrors& h, const std::string& attitude) {
-  JsonWriter w(std::cout);
-  w.BeginObject().Key("hard_iron_uT").BeginArray();
+/// The --format=json object; with `command` (a run folder's summary.json) led by it.
+void WriteJson(std::ostream& out, const MagCalibration& c, const HeadingErrors& h, const std::string& attitude,
+               const std::string& command) {
+  JsonWriter w(out);
+  w.BeginObject();
+  if (!command.empty()) w.Field("command", command);
+  w.Key("hard_iron_uT").BeginArray();
   for (int i = 0; i < 3; ++i) w.Value(c.hard_iron_uT[i]);
   w.EndArray().Key("hard_iron_sigma_uT").BeginArray();
   for (int i = 0; i < 3; ++i) w.Value(c.hard_iron_sigma_uT[i]);
@@ -141,7 +146,6 @@ void PrintJson(const MagCalibration& c, const HeadingErrors& h, const std::strin
       .Field("method", c.method)
       .Field("attitude", attitude)
       .EndObject();
-  std::cout << "\n";
 }
 
 /// The fit of --method; the bidirectional one over the samples with a roll and pitch.
@@ -176,6 +180,7 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
   if (!std::isfinite(FLAGS_declination_deg)) return Usage("--declination_deg must be a finite angle, deg");
   if (!(std::isfinite(FLAGS_field_uT) && FLAGS_field_uT >= 0.0)) return Usage("--field_uT must be >= 0 (0: from the data)");
   const bool two_axis = FLAGS_method == "bidirectional";
+  if (FLAGS_report && FLAGS_run_dir.empty()) return Usage("--report needs --run_dir DIR (it writes DIR/report.html)");
   if (FLAGS_method != "ellipsoid" && FLAGS_field_uT != 0.0) return Usage("--field_uT goes with --method ellipsoid");
 
   std::vector<MagSample> mag = ReadAll<MagSample>(*OpenMag(FLAGS_mag));
@@ -209,14 +214,22 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
               << " (with |pitch| <= 80 deg): heading errors are n/a\n";
   }
 
-  if (!FLAGS_out.empty()) {
-    CalibrationFile file;
-    file.created_by = CommandLine();
-    file.mag = MagCorrection{c.hard_iron_uT, c.correction, c.field_uT};
-    WriteCalibrationFile(FLAGS_out, file);
+  CalibrationFile file;
+  file.created_by = CommandLine();
+  file.mag = MagCorrection{c.hard_iron_uT, c.correction, c.field_uT};
+  if (!FLAGS_run_dir.empty()) {
+    std::ostringstream summary;
+    WriteJson(summary, c, heading, attitude, "calibrate-mag");
+    calibration::WriteCalibrationRunFolder(
+        FLAGS_run_dir, summary.str(), file,
+        {{"residuals.csv", [&c, &mag](std::ostream& o) { calibration::WriteMagResidualsCsv(o, c, mag); }}});
+    std::cerr << "calibrate-mag: run folder " << FLAGS_run_dir << " (summary.json, calibration.yaml, residuals.csv)\n";
+    if (FLAGS_report) WriteRunReport("calibrate-mag", FLAGS_run_dir);
   }
+  if (!FLAGS_out.empty()) WriteCalibrationFile(FLAGS_out, file);
   if (FLAGS_format == "json") {
-    PrintJson(c, heading, attitude);
+    WriteJson(std::cout, c, heading, attitude, "");
+    std::cout << "\n";
   } else {
     PrintText(c, heading, attitude);
     if (!FLAGS_out.empty()) std::printf("calibration file: %s\n", FLAGS_out.c_str());
@@ -230,14 +243,16 @@ Command CalibrateMagCommand() {
   return {"calibrate-mag",
           "Magnetometer hard and soft iron: 3-axis ellipsoid fit, planar fit or the 2-axis bidirectional method",
           "navtwin calibrate-mag --mag F --method ellipsoid|planar|bidirectional [--imu F] [--truth NAV] "
-          "[--declination_deg D] [--field_uT B] [--out FILE] [--format=json]\n"
+          "[--declination_deg D] [--field_uT B] [--out FILE] [--run_dir DIR [--report]] [--format=json]\n"
           "  planar: 3-axis data near one plane (a level turn in any sensor plane); the axis normal to\n"
           "  the plane is not calibrated (reported as uncalibrated_axis_sensor).\n"
           "  Roll and pitch come from --truth, else the --imu accelerometer, else level; the heading error\n"
           "  before and after needs --truth (else n/a). --out writes the calibration file\n"
-          "  (docs/calibration-file.md) that --calibration applies. Data that cannot calibrate (too little\n"
+          "  (docs/calibration-file.md) that --calibration applies; --run_dir the run folder with every\n"
+          "  sample's field magnitude before and after (docs/run-folder.md), --report its page.\n"
+          "  Data that cannot calibrate (too little\n"
           "  rotation) exits 1 with the reason and writes no file.",
-          {"mag", "imu", "truth", "method", "out", "declination_deg", "field_uT"},
+          {"mag", "imu", "truth", "method", "out", "run_dir", "report", "declination_deg", "field_uT"},
           &RunCalibrateMag};
 }
 

@@ -45,7 +45,7 @@ DEFINE_string(vehicle_lever_arm_b_m, "", "x,y,z of the vehicle reference point (
 DEFINE_double(gate_probability, NAN, "Filter: probability of the chi-square gate on each innovation, in (0, 1] (1: no gate; default: the configuration's filter.gate_probability, 0.9999, or 1 for a KF-GINS configuration)");
 DEFINE_bool(variance_components, true, "smooth: estimate each residual group's noise scale in the batch (variance components); false keeps the configured noise");
 DEFINE_bool(strict, false, "Exit with code 3 when the run reports warnings (rejections over 10 %, resets, chi2/dof over 3, inconsistent sigma); the outputs are written either way");
-DEFINE_bool(report, false, "After a successful run, write OUT/report.html (navtwin report OUT: figures and tables)");
+DEFINE_bool(report, false, "After a successful run, write report.html into its run folder (--out DIR; calibrate-imu, calibrate-mag: --run_dir DIR), as navtwin report DIR makes it");
 DEFINE_string(demo_mag, "vector", "smooth --demo: magnetometer use, off|vector|heading|heading_2axis");
 
 namespace navtwin::app {

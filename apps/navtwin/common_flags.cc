@@ -9,6 +9,9 @@ DEFINE_string(format, "text", "Output format of printed results: text or json");
 DEFINE_string(out, "",
               "Output: a folder (ins, navigate, smooth, simulate; created if missing) or a file (convert, "
               "allan: the curve as CSV; calibrate-imu, calibrate-mag: the calibration file)");
+DEFINE_string(run_dir, "",
+              "calibrate-imu, calibrate-mag: also write the run folder (summary.json, calibration.yaml, residuals "
+              "before and after) that navtwin report draws; created if missing");
 DEFINE_uint64(seed, 1, "Random seed of the simulation: the same seed gives the same data, byte for byte "
                        "(Monte Carlo: the first run's seed, run r uses seed + r)");
 DEFINE_int32(runs, 10000, "Number of Monte Carlo runs (level-mc: default 10000; inflight-mc: 50 when not given)");

@@ -10,6 +10,7 @@
 // Output and run control.
 DECLARE_string(format);
 DECLARE_string(out);
+DECLARE_string(run_dir);
 DECLARE_uint64(seed);
 DECLARE_int32(runs);
 DECLARE_int32(threads);

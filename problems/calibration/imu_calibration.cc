@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/imu_error_model.h"
 #include "core/io/csv_imu.h"
 #include "core/io/json_writer.h"
 #include "core/units.h"
@@ -142,10 +143,33 @@ std::string GSensitivityParameterName(int index) {
   return std::string("g_sensitivity.") + kAxis[index / 3] + kAxis[index % 3];
 }
 
-std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::string& rig) {
+std::vector<CalibrationResidual> StaticResiduals(const ImuCalibration& c, const std::vector<StaticPosition>& positions) {
+  std::vector<CalibrationResidual> out;
+  out.reserve(positions.size());
+  for (const StaticPosition& p : positions) {
+    // Without a temperature the constant blocks hold (those at the reference temperature).
+    const double reference_degC = c.temperature ? c.temperature->reference_degC : 0.0;
+    const ImuCalibration at = c.At(std::isfinite(p.temperature_degC) ? p.temperature_degC : reference_degC);
+    CalibrationResidual r;
+    r.t0_s = p.t0_s;
+    r.t1_s = p.t1_s;
+    r.run = p.run;
+    r.temperature_degC = p.temperature_degC;
+    r.accel_before_mps2 = p.f_mean_b_mps2 - p.f_true_b_mps2;
+    r.gyro_before_radps = p.omega_mean_b_radps - p.omega_true_b_radps;
+    r.accel_after_mps2 = p.f_mean_b_mps2 - MeasuredSpecificForce(at.accel.data(), p.f_true_b_mps2);
+    r.gyro_after_radps =
+        p.omega_mean_b_radps - MeasuredRate(at.gyro.data(), at.g_sensitivity.data(), p.omega_true_b_radps, p.f_true_b_mps2);
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::string& rig, const std::string& command) {
   std::ostringstream out;
   JsonWriter json(out);
   json.BeginObject();
+  if (!command.empty()) json.Field("command", command);
   json.Field("rig", rig);
   json.Key("parameters").BeginObject();
   for (const Row& r : AllRows(result)) {
@@ -167,6 +191,35 @@ std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::st
   json.EndArray();
   json.EndObject();
   return out.str();
+}
+
+void WriteImuParametersCsv(std::ostream& out, const ImuCalibrationResult& result) {
+  out << "name,value,sigma,unit\n";
+  for (const Row& r : AllRows(result)) {
+    out << r.name << "," << r.value * r.per_si << "," << r.sigma * r.per_si << "," << r.unit << "\n";
+  }
+}
+
+void WriteImuResidualsCsv(std::ostream& out, const ImuCalibrationResult& result) {
+  out << "t0_s,t1_s,run,temperature_degC,rms";
+  for (const char* sensor : {"accel", "gyro"}) {
+    for (const char* when : {"before", "after"}) {
+      for (const char* axis : {"x", "y", "z"}) {
+        out << "," << sensor << "_" << when << "_" << axis << (sensor[0] == 'a' ? "_mg" : "_deg_h");
+      }
+    }
+  }
+  out << "\n";
+  for (const CalibrationResidual& r : result.residuals) {
+    out << r.t0_s << "," << r.t1_s << "," << r.run << "," << r.temperature_degC << "," << (r.rms ? 1 : 0);
+    for (const Eigen::Vector3d* v : {&r.accel_before_mps2, &r.accel_after_mps2}) {
+      for (int i = 0; i < 3; ++i) out << "," << (*v)(i) / kMilliG_mps2;
+    }
+    for (const Eigen::Vector3d* v : {&r.gyro_before_radps, &r.gyro_after_radps}) {
+      for (int i = 0; i < 3; ++i) out << "," << (*v)(i) / kDegPerHour_radps;
+    }
+    out << "\n";
+  }
 }
 
 std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::string& rig) {

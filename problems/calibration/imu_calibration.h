@@ -18,6 +18,8 @@
 //                  (docs/calibration-temperature.md).
 #pragma once
 
+#include <limits>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,33 @@ namespace navtwin::calibration {
 std::string TriadParameterName(const std::string& triad, int index);
 std::string GSensitivityParameterName(int index);
 
+/// A static position of a record (a table hold, a warm-up segment): the true and the mean
+/// measured specific force and rate in body axes.
+struct StaticPosition {
+  double t0_s = 0.0, t1_s = 0.0;  ///< the window the means are over
+  int run = 0;                    ///< chamber or warm-up run (0 for one record)
+  double temperature_degC = std::numeric_limits<double>::quiet_NaN();  ///< NaN: no temperature
+  Eigen::Vector3d f_true_b_mps2 = Eigen::Vector3d::Zero(), f_mean_b_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d omega_true_b_radps = Eigen::Vector3d::Zero(), omega_mean_b_radps = Eigen::Vector3d::Zero();
+};
+
+/// The residual (measured minus modelled) of a static position without calibration (every
+/// parameter 0: the raw sensor against the truth) and with the estimate; for the pendulum,
+/// which has no static positions, the RMS over one run's samples per axis instead (`rms`).
+struct CalibrationResidual {
+  double t0_s = 0.0, t1_s = 0.0;
+  int run = 0;
+  double temperature_degC = std::numeric_limits<double>::quiet_NaN();
+  bool rms = false;
+  Eigen::Vector3d accel_before_mps2 = Eigen::Vector3d::Zero(), accel_after_mps2 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_before_radps = Eigen::Vector3d::Zero(), gyro_after_radps = Eigen::Vector3d::Zero();
+};
+
+/// The residuals of static positions: mean measured minus the error model of `c` (at the
+/// position's temperature when `c` has temperature terms) applied to the truth, before
+/// (c = 0) and after.
+std::vector<CalibrationResidual> StaticResiduals(const ImuCalibration& c, const std::vector<StaticPosition>& positions);
+
 struct ImuCalibrationResult {
   /// The estimates; parameters not estimated (or unobservable) are 0 with sigma NaN.
   ImuCalibration calibration;
@@ -44,13 +73,27 @@ struct ImuCalibrationResult {
   double gyro_residual_rms_rad_per_s = 0.0;
   int positions = 0;  ///< static positions (multi-position, temperature) or runs (pendulum)
   std::vector<std::string> notes;  ///< e.g. samples left out as saturated
+  /// The static positions the estimate rests on (multi-position, chamber, warm-up; empty for
+  /// the pendulum) and the residuals before and after calibration, in record order.
+  std::vector<StaticPosition> static_positions;
+  std::vector<CalibrationResidual> residuals;
 };
 
 /// Writes {"rig":..,"parameters":{name:{"value":..,"sigma":..},..},"unobservable":[..],
 /// "accel_residual_rms_mps2":..,...} (for --format=json).
-std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::string& rig);
+/// With `command` (a run folder's summary.json) the object starts with "command": command.
+std::string ImuCalibrationJson(const ImuCalibrationResult& result, const std::string& rig,
+                               const std::string& command = "");
 /// A human-readable table: name, value, sigma with units (ppm, mrad, mg, deg/h, deg/h/g).
 std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::string& rig);
+
+/// parameters.csv of the run folder (docs/run-folder.md): `name,value,sigma,unit`, the rows of
+/// the text report, value and σ in `unit` (ppm, mrad, mg, deg/h, …); σ nan where not estimated.
+void WriteImuParametersCsv(std::ostream& out, const ImuCalibrationResult& result);
+/// residuals.csv of the run folder: one row per CalibrationResidual, `t0_s,t1_s,run,
+/// temperature_degC,rms,accel_before_{x,y,z}_mg,accel_after_{x,y,z}_mg,gyro_before_{x,y,z}_deg_h,
+/// gyro_after_{x,y,z}_deg_h` (rms 1: a pendulum run's RMS, 0: a static position's mean residual).
+void WriteImuResidualsCsv(std::ostream& out, const ImuCalibrationResult& result);
 
 /// Reads a record file and calibrates. Throw InputError (file, line, key) for bad records
 /// and std::runtime_error naming what is missing for data that cannot calibrate (too few

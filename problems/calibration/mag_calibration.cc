@@ -279,6 +279,22 @@ Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector
   return RemoveIron(m_uT, c.hard_iron_uT, c.correction);
 }
 
+FieldMagnitude FieldMagnitudeOf(const MagCalibration& c, const Eigen::Vector3d& m_uT) {
+  const Eigen::Vector3d calibrated = ApplyMagCalibration(c, m_uT);
+  const Eigen::Vector3d& n = c.uncalibrated_axis;
+  if (n.squaredNorm() == 0.0) return {m_uT.norm(), calibrated.norm()};
+  const Eigen::Matrix3d in_plane = Eigen::Matrix3d::Identity() - n * n.transpose() / n.squaredNorm();
+  return {(in_plane * m_uT).norm(), (in_plane * calibrated).norm()};
+}
+
+void WriteMagResidualsCsv(std::ostream& out, const MagCalibration& c, const std::vector<MagSample>& samples) {
+  out << "t_s,field_before_uT,field_after_uT\n";
+  for (const MagSample& s : samples) {
+    const FieldMagnitude f = FieldMagnitudeOf(c, s.m_b_uT);
+    out << s.t_s << "," << f.before_uT << "," << f.after_uT << "\n";
+  }
+}
+
 // ------------------------------------------------------------------------ batch ellipsoid
 
 MagCalibration FitEllipsoid(const std::vector<MagSample>& samples, const EllipsoidFitOptions& options) {

@@ -34,6 +34,7 @@
 //    LevelHeading (2-axis), both plus the declination to true north.
 #pragma once
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,18 @@ struct MagCalibration {
 
 /// A (m - h).
 Eigen::Vector3d ApplyMagCalibration(const MagCalibration& c, const Eigen::Vector3d& m_uT);
+
+/// The field magnitude of a sample raw and calibrated, as MagCalibration's spreads measure
+/// it: |m| and |A (m - h)|, or with an uncalibrated axis n their parts normal to n.
+struct FieldMagnitude {
+  double before_uT = 0.0;
+  double after_uT = 0.0;
+};
+FieldMagnitude FieldMagnitudeOf(const MagCalibration& c, const Eigen::Vector3d& m_uT);
+
+/// residuals.csv of `calibrate-mag --run_dir` (docs/run-folder.md): `t_s,field_before_uT,
+/// field_after_uT`, FieldMagnitudeOf every sample.
+void WriteMagResidualsCsv(std::ostream& out, const MagCalibration& c, const std::vector<MagSample>& samples);
 
 enum class MagLoss { kNone, kHuber, kCauchy };
 

@@ -418,6 +418,18 @@ ImuCalibrationResult MakeResult(const Residuals& res, const std::vector<const Me
   out.gyro_residual_rms_rad_per_s = n_g > 0 ? std::sqrt(ss_g / n_g) : 0.0;
   out.positions = positions;
   out.notes = res.notes;
+  for (int i = 0; i < positions && i < static_cast<int>(res.holds.size()); ++i) {
+    const Hold& h = res.holds[i];
+    StaticPosition p;
+    p.t0_s = h.t0_s;
+    p.t1_s = h.t1_s;
+    p.f_true_b_mps2 = h.f_true_b;
+    p.f_mean_b_mps2 = h.f_mean_b;
+    p.omega_true_b_radps = h.omega_true_b;
+    p.omega_mean_b_radps = h.omega_mean_b;
+    out.static_positions.push_back(p);
+  }
+  out.residuals = StaticResiduals(out.calibration, out.static_positions);
   return out;
 }
 

@@ -345,6 +345,28 @@ Eigen::VectorXd Sub(const Regressor& b, const std::vector<int>& keep) {
 
 /// Sum over runs of axis problem a's normal equations, with run `replace` (if >= 0) taken
 /// from `replacement` instead.
+/// One run's residual RMS per axis (over its samples, weighted by dt) before calibration and
+/// at the solution p: the axis problems are accel x, y, z, gyro x, y, z.
+CalibrationResidual RunResidual(const PreparedRun& run, const std::vector<AxisProblem>& axes, const Eigen::VectorXd& p,
+                                int index) {
+  CalibrationResidual out;
+  out.rms = true;
+  out.run = index;
+  out.t0_s = run.meas.empty() ? 0.0 : run.meas.front().t_s;
+  out.t1_s = run.meas.empty() ? 0.0 : run.meas.back().t_s;
+  for (std::size_t a = 0; a < axes.size() && a < 6; ++a) {
+    const Normal& n = run.normals[a];
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(axes[a].params.size());
+    for (std::size_t j = 0; j < axes[a].params.size(); ++j) x(j) = p(axes[a].params[j]);
+    const double w = n.weight_s > 0.0 ? n.weight_s : 1.0;
+    const double before = std::sqrt(std::max(0.0, n.yy) / w);
+    const double after = std::sqrt(std::max(0.0, n.yy - 2.0 * x.dot(n.b) + x.dot(n.N * x)) / w);
+    (a < 3 ? out.accel_before_mps2 : out.gyro_before_radps)(a % 3) = before;
+    (a < 3 ? out.accel_after_mps2 : out.gyro_after_radps)(a % 3) = after;
+  }
+  return out;
+}
+
 Normal Total(const std::vector<PreparedRun>& runs, std::size_t a, int replace = -1,
              const std::vector<Normal>* replacement = nullptr) {
   Normal t;
@@ -683,6 +705,7 @@ ImuCalibrationResult CalibratePendulum(const PendulumData& data, const PendulumO
   }
   result.accel_residual_rms_mps2 = std::sqrt(accel_ss / accel_w);
   result.gyro_residual_rms_rad_per_s = std::sqrt(gyro_ss / gyro_w);
+  for (std::size_t r = 0; r < runs.size(); ++r) result.residuals.push_back(RunResidual(runs[r], axes, p, static_cast<int>(r)));
 
   // The swing fits' uncertainty through the solution: central differences along the
   // columns of each fit's covariance root (exact for a solution linear in the swing).

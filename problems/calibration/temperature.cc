@@ -387,6 +387,14 @@ TemperatureCalibration CalibrateTemperature(const std::vector<TemperatureRun>& r
     result.accel_residual_rms_mps2 = std::sqrt(accel_ss / result.positions);
     result.gyro_residual_rms_rad_per_s = std::sqrt(gyro_ss / result.positions);
   }
+  for (int r = 0; r < n_runs; ++r) {
+    for (StaticPosition p : out.runs[r].static_positions) {
+      p.run = r;
+      p.temperature_degC = out.temperatures_degC[r];
+      result.static_positions.push_back(p);
+    }
+  }
+  result.residuals = StaticResiduals(result.calibration, result.static_positions);
   std::string set_points;
   for (double t : out.temperatures_degC) set_points += (set_points.empty() ? "" : ", ") + Num(t);
   result.notes.insert(result.notes.begin(), std::to_string(n_runs) + " runs at " + set_points + " degC; order " +
@@ -704,6 +712,19 @@ WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const Temp
   result.accel_residual_rms_mps2 = std::sqrt(accel_ss / (3.0 * m));
   result.gyro_residual_rms_rad_per_s = std::sqrt(gyro_ss / (3.0 * m));
   result.positions = positions;
+  for (const WarmUpSegment& seg : out.segments) {
+    StaticPosition p;
+    p.t0_s = seg.t0_s;
+    p.t1_s = seg.t1_s;
+    p.run = seg.run;
+    p.temperature_degC = seg.temperature_degC;
+    p.f_true_b_mps2 = seg.f_true_b_mps2;
+    p.f_mean_b_mps2 = seg.f_mean_b_mps2;
+    p.omega_true_b_radps = seg.omega_true_b_rad_per_s;
+    p.omega_mean_b_radps = seg.omega_mean_b_rad_per_s;
+    result.static_positions.push_back(p);
+  }
+  result.residuals = StaticResiduals(result.calibration, result.static_positions);
   const auto [t_min, t_max] = std::minmax_element(temperatures.begin(), temperatures.end());
   result.notes.push_back(std::to_string(runs.size()) + " warm-up run(s), " + std::to_string(positions) +
                          " static positions cut into " + std::to_string(m) + " segments (segment_s " +

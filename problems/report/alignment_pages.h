@@ -2,6 +2,8 @@
 //   transfer-align: summary.json, <method>/estimates.csv, <method>/attitude_errors.csv (with a truth)
 //   inflight-align: summary.json, <method>/track.csv
 //   level-mc: summary.json, errors.csv
+//   calibrate-imu: summary.json, parameters.csv, residuals.csv
+//   calibrate-mag: summary.json, residuals.csv
 // Each builds the page's tables and its figures (scripts, not yet rendered); report.cc
 // renders them and writes the page (html.h HtmlPage).
 #pragma once
@@ -52,5 +54,11 @@ PageParts InflightPage(const std::vector<AlignmentFolder>& folders, std::size_t 
 /// histograms of the pitch and roll errors over the runs. Throws InputError for a folder
 /// without errors.csv, a method's column missing, or a malformed row.
 PageParts LevelingPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points);
+
+/// calibrate-imu or calibrate-mag folders (all of one kind): the fit and the parameters with σ
+/// (tables, one column per folder), the residuals before and after calibration (IMU: per
+/// static position, log scale; magnetometer: the field magnitude against time). Throws
+/// InputError for a missing or malformed file.
+PageParts CalibrationPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points);
 
 }  // namespace navtwin::report

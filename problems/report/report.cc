@@ -41,10 +41,13 @@ std::string PageKind(const AlignmentFolder& f) {
   const YAML::Node c = JsonChild(f.summary, "command");
   const std::string command = c && c.IsScalar() ? c.Scalar() : "";
   if (command.empty() || command == "navigate" || command == "smooth") return "gnss-ins";
-  if (command == "transfer-align" || command == "inflight-align" || command == "level-mc") return command;
+  if (command == "transfer-align" || command == "inflight-align" || command == "level-mc" ||
+      command == "calibrate-imu" || command == "calibrate-mag") {
+    return command;
+  }
   throw InputError(f.summary_path, c.Mark().line >= 0 ? c.Mark().line + 1 : 0, "command",
                    "'" + command + "' is not a command whose folder the report reads (navigate, smooth, "
-                   "transfer-align, inflight-align, level-mc)");
+                   "transfer-align, inflight-align, level-mc, calibrate-imu, calibrate-mag)");
 }
 
 /// The folders' summary.json and the one kind of page they share; InputError naming the
@@ -67,12 +70,13 @@ std::vector<AlignmentFolder> ReadFolders(const std::vector<std::string>& dirs, s
   return folders;
 }
 
-/// The page of transfer-align, inflight-align or level-mc folders.
+/// The page of transfer-align, inflight-align, level-mc or calibration folders.
 ReportSummary WriteAlignmentReport(const ReportOptions& options, const std::vector<AlignmentFolder>& folders,
                                    const std::string& kind) {
   PageParts page = kind == "transfer-align"   ? TransferPage(folders, options.max_points)
                    : kind == "inflight-align" ? InflightPage(folders, options.max_points)
-                                              : LevelingPage(folders, options.max_points);
+                   : kind == "level-mc"       ? LevelingPage(folders, options.max_points)
+                                              : CalibrationPage(folders, options.max_points);
   if (options.progress) {
     *options.progress << "report: drawing " << page.figures.figures.size() << " figures with gnuplot\n";
   }

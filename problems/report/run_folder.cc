@@ -30,8 +30,8 @@ long MarkLine(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark
 YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path) {
   if (!IsFile(path)) {
     throw InputError(path, 0, "", "no summary.json in " + dir +
-                                      " (not the output folder of navtwin navigate, smooth, transfer-align or "
-                                      "inflight-align)");
+                                      " (not the run folder of navtwin navigate, smooth, transfer-align, "
+                                      "inflight-align, level-mc, calibrate-imu or calibrate-mag)");
   }
   YAML::Node root;
   try {
@@ -40,7 +40,10 @@ YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path) {
     throw InputError(path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "malformed JSON: " + e.msg);
   }
   if (!root.IsMap()) throw InputError(path, 1, "", "expected a JSON object");
-  if (!root["methods"] || !root["methods"].IsMap() || root["methods"].size() == 0) {
+  const YAML::Node command = root["command"];
+  const bool calibration =
+      command && command.IsScalar() && (command.Scalar() == "calibrate-imu" || command.Scalar() == "calibrate-mag");
+  if (!calibration && (!root["methods"] || !root["methods"].IsMap() || root["methods"].size() == 0)) {
     throw InputError(path, MarkLine(root), "methods", "missing or empty object 'methods'");
   }
   return root;

@@ -90,7 +90,7 @@ RunData LoadRunFolder(const std::string& dir, const std::string& label, bool lab
                       std::size_t max_points, int jobs);
 
 /// summary.json of the folder `dir` (at `path`): an object with a non-empty "methods"
-/// object. Throws InputError (file, line, field) when it is missing or malformed.
+/// object (but for the calibration commands' folders, which have none). Throws InputError (file, line, field) when it is missing or malformed.
 YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path);
 
 /// A number of summary.json: NaN for null or absent; InputError naming the file, line and

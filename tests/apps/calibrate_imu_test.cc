@@ -77,6 +77,27 @@ const char kPendulumErrors[] =
     "    gyro: {bias_deg_h: 200, arw_deg_sqrt_h: 0.3, scale_factor_ppm: 3000, misalignment_arcsec: 600}\n"
     "    accel: {bias_ug: 5000, vrw_m_s_sqrt_h: 0.05, scale_factor_ppm: 3000, misalignment_arcsec: 600}\n";
 
+// --run_dir writes the run folder (one residual row per static position) and --report its
+// page; --report alone is a usage error.
+TEST(CalibrateImuTest, RunFolderAndReport) {
+  const std::string dir = MakeTempDir("calibrate_run_dir");
+  ASSERT_EQ(Navtwin("simulate --scenario " + kDocs + "table-mems.yaml --seed 2 --out " + dir + "/table").exit_code, 0);
+  WriteRecord(dir + "/record.yaml", dir + "/table/imu.txt");
+  const std::string base = "calibrate-imu --rig multiposition --data " + dir + "/record.yaml";
+  const RunResult r = Navtwin(base + " --format=json --run_dir " + dir + "/run --report");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* file : {"summary.json", "calibration.yaml", "parameters.csv", "residuals.csv", "report.html"}) {
+    EXPECT_TRUE(Exists(dir + "/run/" + file)) << file;
+  }
+  const int positions = static_cast<int>(JsonNumberAfter(r.out, "{", "positions"));
+  EXPECT_EQ(Occurrences(ReadAll(dir + "/run/residuals.csv"), "\n"), static_cast<std::size_t>(positions + 1));
+  EXPECT_EQ(Occurrences(ReadAll(dir + "/run/report.html"), "<figure"), 2u);
+  EXPECT_NE(ReadAll(dir + "/run/summary.json").find("\"command\":\"calibrate-imu\""), std::string::npos);
+  const RunResult usage = Navtwin(base + " --report");
+  EXPECT_EQ(usage.exit_code, 2);
+  EXPECT_NE(usage.err.find("--run_dir"), std::string::npos) << usage.err;
+}
+
 TEST(CalibrateImuTest, PendulumRecordFromSimulatedMountings) {
   const std::string dir = MakeTempDir("pendulum_cli");
   std::string record = "latitude_deg: 37.45\nheight_m: 40\nruns:\n";

@@ -3,6 +3,7 @@
 // turn of a 2-axis sensor (bidirectional), a level turn of a 3-axis sensor (planar), the
 // calibration file it writes, and bad input
 // (exit non-zero, a message naming file, line and field, no output file).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -125,6 +126,40 @@ TEST_F(CalibrateMagTest, EllipsoidOnARateTableRecoversTheHardIronAndTheHeading) 
   ASSERT_EQ(json.exit_code, 0) << json.err;
   EXPECT_NE(json.out.find("\"heading_error_before_deg\":null"), std::string::npos) << json.out;
   EXPECT_EQ(json.out.find("nan"), std::string::npos) << json.out;
+}
+
+// --run_dir: every sample's field before and after (flat at the field after the fit), the
+// calibration file beside it, and the page with --report.
+TEST_F(CalibrateMagTest, RunFolderHoldsTheFieldBeforeAndAfter) {
+  Simulate("table", std::string(kTable) + kMagSection);
+  const std::string run = dir_ + "/run";
+  const RunResult r =
+      Navtwin("calibrate-mag --mag " + dir_ + "/table/mag.csv --method ellipsoid --report --run_dir " + run);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* file : {"summary.json", "calibration.yaml", "residuals.csv", "report.html"}) {
+    EXPECT_TRUE(Exists(run + "/" + file)) << file;
+  }
+  std::ifstream csv(run + "/residuals.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "t_s,field_before_uT,field_after_uT");
+  double min_before = 1e9, max_before = 0.0, min_after = 1e9, max_after = 0.0;
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    double t = 0.0, before = 0.0, after = 0.0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &t, &before, &after), 3) << line;
+    min_before = std::min(min_before, before);
+    max_before = std::max(max_before, before);
+    min_after = std::min(min_after, after);
+    max_after = std::max(max_after, after);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 1201);  // 60 s at 20 Hz, both ends
+  // 12 uT of hard iron swings |m| by ~25 uT over the attitudes; after, the 0.3 uT noise
+  // (±5σ over 1201 samples: 3 uT).
+  EXPECT_GT(max_before - min_before, 15.0);
+  EXPECT_LT(max_after - min_after, 3.0);
+  EXPECT_EQ(Occurrences(ReadAll(run + "/report.html"), "<figure"), 1u);
 }
 
 TEST_F(CalibrateMagTest, BidirectionalOnALevelTurnOfA2AxisSensor) {

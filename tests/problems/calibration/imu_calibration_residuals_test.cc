@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "core/sim/random.h"
+#include "problems/calibration/imu_calibration.h"
 
 namespace navtwin::calibration {
 namespace calibration_imu_calibration_residuals_test {
@@ -77,6 +78,45 @@ TEST(StaticResidualsTest, ZeroAtTheTrueParameters) {
   EXPECT_LT(r.norm(), 1e-9);  // rounding of 10 m/s^2 over sigma 1e-4
   ASSERT_TRUE(g(p.data(), g9.data(), r.data()));
   EXPECT_LT(r.norm(), 1e-9);
+}
+
+// The report's residual rows (imu_calibration.h StaticResiduals): a position measured
+// with the calibration's own errors at its temperature has zero residual after and the raw
+// error before; evaluated at another temperature the temperature terms show.
+TEST(CalibrationResidualRowsTest, AfterIsZeroForTheModelsOwnErrorsAtTheirTemperature) {
+  ImuCalibration c;
+  c.accel << 500e-6, -300e-6, 200e-6, 1e-3, -2e-3, 0.5e-3, 1.5e-3, -1e-3, 2e-3, 0.02, -0.01, 0.03;
+  c.gyro << 100e-6, 50e-6, -80e-6, 0.3e-3, -0.2e-3, 0.1e-3, 0.4e-3, -0.3e-3, 0.2e-3, 1e-4, -2e-4, 5e-5;
+  c.g_sensitivity << 1e-5, 0, 0, 0, 2e-5, 0, 0, 0, -1e-5;
+  TemperatureTerms t;
+  t.reference_degC = 25.0;
+  t.accel_bias_mps2 = {Eigen::Vector3d(1e-4, -2e-4, 3e-4)};
+  t.accel_scale_factor = {Eigen::Vector3d::Zero()};
+  t.gyro_bias_rad_per_s = {Eigen::Vector3d(1e-6, 2e-6, -1e-6)};
+  t.gyro_scale_factor = {Eigen::Vector3d::Zero()};
+  c.temperature = t;
+  StaticPosition p;
+  p.t0_s = 1.0;
+  p.t1_s = 9.0;
+  p.temperature_degC = 45.0;
+  p.f_true_b_mps2 = Eigen::Vector3d(1.0, -2.0, -9.5);
+  p.omega_true_b_radps = Eigen::Vector3d(3e-5, -2e-5, 6e-5);
+  const ImuCalibration at = c.At(p.temperature_degC);
+  p.f_mean_b_mps2 = MeasuredSpecificForce(at.accel.data(), p.f_true_b_mps2);
+  p.omega_mean_b_radps = MeasuredRate(at.gyro.data(), at.g_sensitivity.data(), p.omega_true_b_radps, p.f_true_b_mps2);
+  const std::vector<CalibrationResidual> rows = StaticResiduals(c, {p});
+  ASSERT_EQ(rows.size(), 1u);
+  // Rounding of ~10 m/s^2 and ~1e-4 rad/s values.
+  EXPECT_LT(rows[0].accel_after_mps2.norm(), 1e-14);
+  EXPECT_LT(rows[0].gyro_after_radps.norm(), 1e-18);
+  EXPECT_LT((rows[0].accel_before_mps2 - (p.f_mean_b_mps2 - p.f_true_b_mps2)).norm(), 1e-15);
+  EXPECT_EQ(rows[0].t0_s, 1.0);
+  EXPECT_EQ(rows[0].temperature_degC, 45.0);
+  // Taken at the reference temperature instead, the 20 degC of bias slope remain.
+  p.temperature_degC = 25.0;
+  const CalibrationResidual wrong = StaticResiduals(c, {p}).front();
+  EXPECT_NEAR(wrong.accel_after_mps2.x(), 20.0 * 1e-4, 1e-12);
+  EXPECT_NEAR(wrong.gyro_after_radps.y(), 20.0 * 2e-6, 1e-15);
 }
 
 }  // namespace calibration_imu_calibration_residuals_test

@@ -171,6 +171,34 @@ TEST(MultiPositionTest, RecoversFixedErrorsExactlyWithoutNoise) {
   EXPECT_LT(err.segment<3>(21).cwiseAbs().maxCoeff(), 3e-9);     // gyro bias, rad/s (1.3e-9)
   EXPECT_LT(err.tail<9>().cwiseAbs().maxCoeff(), 1e-8);          // (rad/s)/(m/s^2) (5.8e-9)
   EXPECT_LT(r.accel_residual_rms_mps2, 1e-8);
+  // The residuals before and after per position: before, the raw sensor's errors (its
+  // biases alone are mg and hundreds of deg/h); after, rounding and the coning truncation.
+  ASSERT_EQ(r.residuals.size(), 24u);
+  ASSERT_EQ(r.static_positions.size(), 24u);
+  for (const CalibrationResidual& res : r.residuals) {
+    EXPECT_GT(res.accel_before_mps2.norm(), 1e-4);
+    EXPECT_LT(res.accel_after_mps2.norm(), 1e-8);
+    EXPECT_LT(res.t0_s, res.t1_s);
+    EXPECT_FALSE(res.rms);
+  }
+}
+
+// The residual rows are the fit's own: their RMS after calibration over every axis of
+// every position is the reported residual RMS (same formula, to rounding), with noise.
+TEST(MultiPositionTest, ResidualRowsAgreeWithTheReportedRms) {
+  const sim::MultiPositionConfig table = Table(TwentyFourPositions(), 5.0, 3.0);
+  sim::InertialErrorModel* model = nullptr;
+  const ImuCalibrationResult r = CalibrateMultiPosition(Data(table, Measure(Truth(table), Tactical(), 7, &model)));
+  ASSERT_EQ(r.residuals.size(), 24u);
+  double ss_a = 0.0, ss_g = 0.0, before_a = 0.0;
+  for (const CalibrationResidual& res : r.residuals) {
+    ss_a += res.accel_after_mps2.squaredNorm();
+    ss_g += res.gyro_after_radps.squaredNorm();
+    before_a += res.accel_before_mps2.squaredNorm();
+  }
+  EXPECT_NEAR(std::sqrt(ss_a / 72.0) / r.accel_residual_rms_mps2, 1.0, 1e-9);
+  EXPECT_NEAR(std::sqrt(ss_g / 72.0) / r.gyro_residual_rms_rad_per_s, 1.0, 1e-9);
+  EXPECT_GT(before_a, 100.0 * ss_a);  // the calibration removes the tactical IMU's errors
 }
 
 TEST(MultiPositionTest, MonteCarloSigmaIsHonest) {

@@ -13,6 +13,9 @@
 #include <gtest/gtest.h>
 
 #include "core/io/input_error.h"
+#include "problems/calibration/calibration_run_folder.h"
+#include "problems/calibration/imu_calibration.h"
+#include "problems/calibration/mag_calibration.h"
 #include "problems/report/report.h"
 #include "tests/report_page_check.h"
 #include "tests/scratch_dir.h"
@@ -106,6 +109,54 @@ class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
                               "\"pitch_error_over_sigma_rms\":1.05,\"fallbacks\":0,\"cpu_time_s\":0.5";
     Write(name + "/summary.json", "{\"command\":\"level-mc\",\"runs\":400,\"run_time_s\":1.0,\"methods\":{"
                                   "\"plain_mean\":{" + stats + "},\"batch\":{" + stats + "}}}\n");
+    return dir_ + "/" + name;
+  }
+  /// A calibrate-imu folder written by the command's writers: 8 positions whose raw errors
+  /// are 5 mg / 100 deg/h, 0.01 mg / 1 deg/h after.
+  std::string ImuCalibrationFolder(const std::string& name) {
+    calibration::ImuCalibrationResult r;
+    r.calibration.accel(9) = 0.05;
+    r.calibration.accel_sigma = Eigen::Matrix<double, kTriadParameters, 1>::Constant(1e-4);
+    r.positions = 8;
+    for (int k = 0; k < 8; ++k) {
+      calibration::CalibrationResidual res;
+      res.t0_s = 10.0 * k;
+      res.t1_s = res.t0_s + 8.0;
+      res.accel_before_mps2 = Eigen::Vector3d(0.049, 0.01 * std::sin(k), 0.0);
+      res.accel_after_mps2 = Eigen::Vector3d(1e-4 * std::cos(k), 0.0, 0.0);
+      res.gyro_before_radps = Eigen::Vector3d(4.8e-4, 0.0, 1e-5 * k);
+      res.gyro_after_radps = Eigen::Vector3d(0.0, 4.8e-6, 0.0);
+      r.residuals.push_back(res);
+    }
+    CalibrationFile file;
+    file.imu = r.calibration;
+    calibration::WriteCalibrationRunFolder(
+        dir_ + "/" + name, calibration::ImuCalibrationJson(r, "multiposition", "calibrate-imu"), file,
+        {{"parameters.csv", [&r](std::ostream& o) { calibration::WriteImuParametersCsv(o, r); }},
+         {"residuals.csv", [&r](std::ostream& o) { calibration::WriteImuResidualsCsv(o, r); }}});
+    return dir_ + "/" + name;
+  }
+  /// A calibrate-mag folder: 400 samples of a turning sensor with 10 uT of hard iron.
+  std::string MagCalibrationFolder(const std::string& name) {
+    calibration::MagCalibration c;
+    c.hard_iron_uT = Eigen::Vector3d(10.0, 0.0, 0.0);
+    c.field_uT = 50.0;
+    std::vector<MagSample> samples;
+    for (int k = 0; k < 400; ++k) {
+      MagSample m;
+      m.t_s = 0.05 * k;
+      m.m_b_uT = c.hard_iron_uT + 50.0 * Eigen::Vector3d(std::cos(0.02 * k), std::sin(0.02 * k), 0.0);
+      samples.push_back(m);
+    }
+    CalibrationFile file;
+    file.mag = MagCorrection{c.hard_iron_uT, c.correction, c.field_uT};
+    calibration::WriteCalibrationRunFolder(
+        dir_ + "/" + name,
+        "{\"command\":\"calibrate-mag\",\"hard_iron_uT\":[10,0,0],\"hard_iron_sigma_uT\":[0.1,0.1,0.1],"
+        "\"field_uT\":50,\"residual_rms_uT\":0.3,\"field_spread_before_uT\":7.1,\"field_spread_after_uT\":0.3,"
+        "\"heading_error_before_deg\":null,\"heading_error_after_deg\":null,\"heading_samples\":0,"
+        "\"samples\":400,\"method\":\"ellipsoid\"}",
+        file, {{"residuals.csv", [&](std::ostream& o) { calibration::WriteMagResidualsCsv(o, c, samples); }}});
     return dir_ + "/" + name;
   }
   std::string Report(const std::vector<std::string>& dirs) {
@@ -244,6 +295,28 @@ TEST_F(AlignmentReportTest, LevelingHistograms) {
   Write("lv/errors.csv", "run,plain_mean_pitch_deg,plain_mean_roll_deg\n0,0.1,0.2\n");
   const std::string e = ReportError({dir_ + "/lv"}, dir_ + "/lv_bad.html");
   EXPECT_NE(e.find("batch_pitch_deg"), std::string::npos) << e;
+}
+
+// The calibration pages from folders the commands' writers made: the IMU residuals before
+// and after per position (one open and one filled series per folder), the parameters with
+// σ; the magnetometer field before and after; a column missing from residuals.csv named.
+TEST_F(AlignmentReportTest, CalibrationPagesShowResidualsBeforeAndAfter) {
+  const std::string imu = ImuCalibrationFolder("cal_a");
+  for (const char* file : {"summary.json", "calibration.yaml", "parameters.csv", "residuals.csv"}) {
+    EXPECT_TRUE(navtwin::testing::FileExists(imu + "/" + file)) << file;
+  }
+  const std::string html = Report({imu, ImuCalibrationFolder("cal_b")});
+  ExpectFigures(html, {{"accel_residuals", 4}, {"gyro_residuals", 4}});
+  for (const char* text : {"accel.bias.x", "cal_b value", "multiposition", "<td>8</td>"}) {
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  }
+  const std::string mag = Report({MagCalibrationFolder("mag")});
+  ExpectFigures(mag, {{"mag_field", 2}});
+  EXPECT_NE(mag.find("10.000 (0.100)"), std::string::npos);
+
+  Write("cal_a/residuals.csv", "t0_s,t1_s,run,temperature_degC,rms\n0,1,0,nan,0\n");
+  const std::string e = ReportError({imu}, dir_ + "/cal_bad.html");
+  EXPECT_NE(e.find("accel_before_x_mg"), std::string::npos) << e;
 }
 
 }  // namespace
