@@ -1,6 +1,6 @@
 // navtwin report RUN_DIR [RUN_DIR...] --out report.html: one self-contained HTML page with
-// the figures and summary tables of navigate / smooth run folders (problems/report/report.h;
-// docs/report.md).
+// the figures and summary tables of run folders (navigate, smooth, transfer-align,
+// inflight-align, level-mc, calibrate-imu, calibrate-mag; problems/report/report.h, docs/report.md).
 #include <gflags/gflags.h>
 
 #include <iostream>
@@ -11,12 +11,14 @@
 #include "apps/navtwin/common_flags.h"
 #include "problems/report/report.h"
 
+DEFINE_string(figures_dir, "", "report: also write every figure as DIR/<figure id>.svg (for documents)");
 DEFINE_int32(max_points, 2000, "report: most points drawn per plotted series (thinned keeping extremes; the tables use every row)");
 
 namespace navtwin::app {
 namespace {
 
-const char* const kReportUsage = "navtwin report RUN_DIR [RUN_DIR...] --out report.html [--max_points N]";
+const char* const kReportUsage =
+    "navtwin report RUN_DIR [RUN_DIR...] --out report.html [--max_points N] [--figures_dir DIR]";
 
 int RunReport(const std::vector<std::string>& args) {
   const auto usage = [](const std::string& why) {
@@ -30,6 +32,7 @@ int RunReport(const std::vector<std::string>& args) {
   options.run_dirs = args;
   options.out_path = FLAGS_out;
   options.max_points = static_cast<std::size_t>(FLAGS_max_points);
+  options.figures_dir = FLAGS_figures_dir;
   options.progress = &std::cerr;
   const report::ReportSummary summary = report::WriteReport(options);
   for (const std::string& why : summary.left_out) std::cerr << "report: left out: " << why << "\n";
@@ -40,8 +43,8 @@ int RunReport(const std::vector<std::string>& args) {
 }  // namespace
 
 Command ReportCommand() {
-  return {"report", "HTML report (figures and tables) of one or several navigate/smooth run folders", kReportUsage,
-          {"out", "max_points"}, &RunReport};
+  return {"report", "HTML report (figures and tables) of one or several run folders of one command", kReportUsage,
+          {"out", "max_points", "figures_dir"}, &RunReport};
 }
 
 }  // namespace navtwin::app

@@ -1,22 +1,26 @@
 #!/bin/sh
-# Re-makes docs/inflight/heading_vs_distance*.png: the heading error of the three methods
-# of issue 7 against the distance flown on the preset inflight-mach07-south (seed 1),
-# without and with 1 % GPS outliers of 200 m (batch with and without its robust loss).
-# Usage: docs/inflight/plot.sh [NAVTWIN_BINARY]   (default: build/bin/navtwin)
+# The heading error of the three in-flight alignment methods (distance, kalman, batch) against
+# the distance flown on the preset inflight-mach07-south (seed 1), as run folders and one
+# `navtwin report` over them: `clean` (no outliers), `outliers` (1 % GPS outliers of 200 m)
+# and `outliers_noloss` (the batch on the same data without its robust loss). The report's
+# heading-error figures are the ones docs/inflight-alignment.md shows; clean.html is the
+# clean run's own page.
+# Usage: docs/inflight/plot.sh [NAVTWIN [OUT_DIR]]   (defaults: build/bin/navtwin, a new
+#   temporary folder). Nothing is written into the repository; to refresh the documentation,
+#   copy OUT_DIR/figures_clean/heading_error.svg to docs/inflight/heading_vs_distance.svg,
+#   OUT_DIR/figures_clean/heading_error_second_half.svg to heading_vs_distance_second_half.svg
+#   and OUT_DIR/figures/heading_error_second_half.svg to heading_vs_distance_outliers.svg.
 set -eu
 navtwin=${1:-build/bin/navtwin}
-here=$(dirname "$0")
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-for m in distance kalman batch; do
-  "$navtwin" inflight-align --scenario inflight-mach07-south --seed 1 --method $m \
-    --track_csv "$tmp/clean_$m.csv" > /dev/null
-  "$navtwin" inflight-align --scenario inflight-mach07-south --seed 1 --method $m \
-    --outlier_fraction 0.01 --outlier_m 200 --track_csv "$tmp/outliers_$m.csv" > /dev/null
-done
-printf 'batch:\n  loss: none\n' > "$tmp/no_loss.yaml"
-"$navtwin" inflight-align --scenario inflight-mach07-south --seed 1 --method batch \
-  --outlier_fraction 0.01 --outlier_m 200 --config "$tmp/no_loss.yaml" \
-  --track_csv "$tmp/outliers_batch_noloss.csv" > /dev/null
-gnuplot -e "dir='$tmp'; outdir='$here'" "$here/heading_vs_distance.gp"
-ls -l "$here"/heading_vs_distance*.png
+out=${2:-$(mktemp -d)}
+mkdir -p "$out"
+common="inflight-align --scenario inflight-mach07-south --seed 1"
+"$navtwin" $common --method all --out "$out/clean" > /dev/null
+"$navtwin" $common --method all --outlier_fraction 0.01 --outlier_m 200 --out "$out/outliers" > /dev/null
+printf 'batch:\n  loss: none\n' > "$out/no_loss.yaml"
+"$navtwin" $common --method batch --outlier_fraction 0.01 --outlier_m 200 --config "$out/no_loss.yaml" \
+  --out "$out/outliers_noloss" > /dev/null
+"$navtwin" report "$out/clean" --out "$out/clean.html" --figures_dir "$out/figures_clean"
+"$navtwin" report "$out/clean" "$out/outliers" "$out/outliers_noloss" --out "$out/report.html" \
+  --figures_dir "$out/figures"
+echo "report: $out/report.html (clean run alone: $out/clean.html); figures: $out/figures/, $out/figures_clean/"

@@ -41,8 +41,10 @@ PageText AlignmentPageText(const std::vector<AlignmentFolder>& folders, const st
 
 /// transfer-align folders: per method the attitude errors and the final estimates (tables),
 /// the misalignment and the delay against time with ±3σ bands and the true values, the
-/// slave's attitude errors. Throws InputError (file, line, field) for a method without
-/// estimates.csv or a malformed file. Series are labelled folder/method with several folders.
+/// slave's attitude errors; with three or more folders of distinct true delays (a sweep) the
+/// attitude RMS of each method against the true delay. Throws InputError (file, line, field)
+/// for a method without estimates.csv or a malformed file. Series are labelled
+/// folder/method with several folders.
 PageParts TransferPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points);
 
 /// inflight-align folders: per method the heading error and σ at the distances and at the

@@ -275,15 +275,18 @@ std::string AdaptedNoiseList(const std::vector<RunData>& runs) {
          items + "</ul>\n";
 }
 
-/// Letters, digits, '-' and '_' of the figure id: an anchor.
-std::string Anchor(const std::string& id) {
+}  // namespace
+
+std::string HtmlAnchor(const std::string& id) {
   std::string out;
   for (char c : id) out += std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' ? c : '_';
   return out;
 }
 
+namespace {
+
 std::string FigureHtml(const Figure& f) {
-  return "<figure id=\"" + Anchor(f.id) + "\" data-series=\"" + std::to_string(f.series) + "\">\n<h3>" +
+  return "<figure id=\"" + HtmlAnchor(f.id) + "\" data-series=\"" + std::to_string(f.series) + "\">\n<h3>" +
          HtmlEscape(f.title) + "</h3>\n<img alt=\"" + HtmlEscape(f.title) + "\" width=\"" + std::to_string(f.width_px) +
          "\" height=\"" + std::to_string(f.height_px) + "\" src=\"data:image/svg+xml;base64," + Base64(f.svg) +
          "\">\n<figcaption>" + HtmlEscape(f.caption) + "</figcaption>\n</figure>\n";
@@ -291,9 +294,9 @@ std::string FigureHtml(const Figure& f) {
 
 std::string Contents(const std::vector<PageSection>& sections, const std::vector<Figure>& figures) {
   std::string s = "<nav><ul>\n";
-  for (const PageSection& p : sections) s += "<li><a href=\"#" + Anchor(p.id) + "\">" + HtmlEscape(p.title) + "</a></li>";
+  for (const PageSection& p : sections) s += "<li><a href=\"#" + HtmlAnchor(p.id) + "\">" + HtmlEscape(p.title) + "</a></li>";
   s += "\n";
-  for (const Figure& f : figures) s += "<li><a href=\"#" + Anchor(f.id) + "\">" + HtmlEscape(f.title) + "</a></li>\n";
+  for (const Figure& f : figures) s += "<li><a href=\"#" + HtmlAnchor(f.id) + "\">" + HtmlEscape(f.title) + "</a></li>\n";
   return s + "<li><a href=\"#left_out\">Left out</a></li></ul></nav>\n";
 }
 

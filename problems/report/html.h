@@ -44,6 +44,10 @@ std::string HtmlHead(const std::vector<std::string>& names, std::size_t text_col
 std::string ReportHtml(const std::vector<RunData>& runs, const std::vector<Figure>& figures,
                        const std::vector<std::string>& left_out);
 
+/// Letters, digits, '-' and '_' of a figure id (others become '_'): its anchor in the page
+/// and its file name with --figures_dir.
+std::string HtmlAnchor(const std::string& id);
+
 /// Text made safe inside HTML elements and attribute values.
 std::string HtmlEscape(const std::string& text);
 

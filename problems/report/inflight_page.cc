@@ -103,23 +103,43 @@ std::string InflightNotes(const std::vector<InflightMethod>& methods) {
   return items.empty() ? "" : "<h3>Notes of the runs</h3>\n<ul>\n" + items + "</ul>\n";
 }
 
-void InflightErrorFigure(const std::vector<InflightMethod>& methods, FigureSet* out) {
+/// The heading error against distance with ±3σ bands; with `second_half` only the second
+/// half of the distance flown (where the bands of the start no longer set the scale).
+void InflightErrorFigure(const std::vector<InflightMethod>& methods, bool second_half, FigureSet* out) {
   std::vector<BandedSeries> list;
+  double longest_km = 0.0;
   for (const InflightMethod& m : methods) {
-    if (m.has_errors) list.push_back({m.label, m.color, m.track.t, m.track.y[1], m.track.y[0]});
+    for (const double d : m.track.t) {
+      if (std::isfinite(d)) longest_km = std::max(longest_km, d);
+    }
+  }
+  const double from_km = second_half ? 0.5 * longest_km : -INFINITY;
+  for (const InflightMethod& m : methods) {
+    if (!m.has_errors) continue;
+    BandedSeries b{m.label, m.color, {}, {}, {}};
+    for (std::size_t i = 0; i < m.track.t.size(); ++i) {
+      if (!(m.track.t[i] >= from_km)) continue;
+      b.x.push_back(m.track.t[i]);
+      b.y.push_back(m.track.y[1][i]);
+      b.sigma.push_back(m.track.y[0][i]);
+    }
+    list.push_back(std::move(b));
   }
   if (list.empty()) {
-    out->left_out.push_back("Heading error against distance: no heading errors in any track.csv (run without a truth)");
+    if (!second_half) {
+      out->left_out.push_back("Heading error against distance: no heading errors in any track.csv (run without a truth)");
+    }
     return;
   }
   Figure f;
-  f.id = "heading_error";
-  f.title = "Heading error against distance";
+  f.id = second_half ? "heading_error_second_half" : "heading_error";
+  f.title = second_half ? "Heading error, second half of the distance" : "Heading error against distance";
   f.script = GnuplotCommon() + "set ylabel 'heading error [arcmin]'\nset xlabel 'distance flown [km]'\n";
-  f.script += BandedErrorPlot(list, "h", &f);
+  f.script += BandedErrorPlot(list, second_half ? "z" : "h", &f);
   f.caption = "Heading error (estimate − truth, track.csv error_arcmin) of each method against the distance flown, "
-              "with its ±3σ band (σ: sigma_arcmin) shaded in the same colour. The y range is clipped to 1.15 × the "
-              "99th percentile of max(|error|, 3σ). Thinned uniformly.";
+              "with its ±3σ band (σ: sigma_arcmin) shaded in the same colour" +
+              std::string(second_half ? ", from half the longest distance on" : "") +
+              ". The y range is clipped to 1.15 × the 99th percentile of max(|error|, 3σ). Thinned uniformly.";
   out->figures.push_back(std::move(f));
 }
 
@@ -162,7 +182,8 @@ PageParts InflightPage(const std::vector<AlignmentFolder>& folders, std::size_t 
           InflightTable(methods, "Heading σ [arcmin] at the distance flown", "heading_sigma_arcmin_at_km", {}) +
           InflightNotes(methods));
   page.text.notes = notes;
-  InflightErrorFigure(methods, &page.figures);
+  InflightErrorFigure(methods, false, &page.figures);
+  InflightErrorFigure(methods, true, &page.figures);
   page.figures.figures.push_back(InflightSigmaFigure(methods));
   return page;
 }

@@ -76,39 +76,76 @@ std::string LevelingTable(const std::vector<LevelingMethod>& methods) {
   return s + "</table>\n";
 }
 
-/// Overlaid step histograms of one error (pitch or roll) of every method, on common bins
-/// over [-L, L] with L the largest finite |error| of all methods.
-Figure HistogramFigure(const std::vector<LevelingMethod>& methods, bool pitch) {
-  const char* what = pitch ? "pitch" : "roll";
-  double limit = 0.0;
-  for (const LevelingMethod& m : methods) {
-    for (const double e : pitch ? m.pitch_deg : m.roll_deg) {
-      if (std::isfinite(e)) limit = std::max(limit, std::abs(e));
-    }
+/// RMS of the finite values (NaN without any).
+double FiniteRms(const std::vector<double>& v) {
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (const double x : v) {
+    if (std::isfinite(x)) ss += x * x, ++n;
   }
+  return n > 0 ? std::sqrt(ss / static_cast<double>(n)) : NAN;
+}
+
+/// One panel of a histogram figure: the method's errors on kHistogramBins bins over [-L, L],
+/// L its largest finite |error| but at most 6 × its RMS (heavy tails would squeeze the
+/// histogram into a few bins; the runs beyond are counted in the key), and the normal
+/// density of its RMS dashed. Appends the datablock `name` and returns the plot command.
+std::string HistogramPanel(const LevelingMethod& m, const std::vector<double>& e, const std::string& name,
+                           Figure* f) {
+  const double rms = FiniteRms(e);
+  double largest = 0.0;
+  for (const double x : e) {
+    if (std::isfinite(x)) largest = std::max(largest, std::abs(x));
+  }
+  double limit = rms > 0.0 ? std::min(largest, 6.0 * rms) : largest;
   if (!(limit > 0.0)) limit = 1.0;
   const double width = 2.0 * limit / kHistogramBins;
+  std::vector<double> centres(kHistogramBins), counts(kHistogramBins, 0.0);
+  for (int b = 0; b < kHistogramBins; ++b) centres[b] = -limit + (b + 0.5) * width;
+  std::size_t runs = 0, beyond = 0;
+  for (const double x : e) {
+    if (!std::isfinite(x)) continue;
+    ++runs;
+    if (std::abs(x) > limit) {
+      ++beyond;
+      continue;
+    }
+    counts[std::min(kHistogramBins - 1, static_cast<int>((x + limit) / width))] += 1.0;
+  }
+  AppendDatablock(&f->script, name, {centres, counts});
+  std::string title = m.label + ": RMS " + GnuplotNumber("%.3g", rms) + " deg";
+  if (beyond > 0) title += ", " + std::to_string(beyond) + " beyond";
+  const double s = rms > 0.0 ? rms : 1.0;
+  f->series += 2;
+  return "set xrange [" + GnuplotNumber("%.9g", -limit) + ":" + GnuplotNumber("%.9g", limit) + "]\nplot $" + name +
+         " u 1:2 w histeps lw 1.4 lc rgb '" + m.color + "' title " + GnuplotQuote(title) + ", " +
+         GnuplotNumber("%.9g", static_cast<double>(runs) * width / (s * std::sqrt(2.0 * M_PI))) + " * exp(-0.5 * (x / " +
+         GnuplotNumber("%.9g", s) + ")**2) w l dt 2 lw 1.2 lc rgb '#000000' title 'normal, same RMS'\n";
+}
+
+/// The histograms of one error (pitch or roll): one panel per method (two columns), each
+/// on its own range.
+Figure HistogramFigure(const std::vector<LevelingMethod>& methods, bool pitch) {
+  const char* what = pitch ? "pitch" : "roll";
+  const std::size_t columns = methods.size() > 1 ? 2 : 1;
+  const std::size_t rows = (methods.size() + columns - 1) / columns;
   Figure f;
   f.id = std::string(what) + "_histogram";
-  f.title = std::string("Histogram of the ") + what + " error";
-  f.script = GnuplotCommon() + "set ylabel 'runs per bin'\nset xlabel '" + what + " error [deg]'\n";
-  std::string plots;
+  f.title = std::string("Histograms of the ") + what + " error";
+  f.height_px = static_cast<int>(std::max<std::size_t>(1, rows)) * 320 + 80;
+  f.script = GnuplotCommon() + "set multiplot layout " + std::to_string(rows) + "," + std::to_string(columns) +
+             "\nset ylabel 'runs per bin'\nset xlabel '" + what + " error [deg]'\nset samples 400\n" +
+             "set offsets 0, 0, graph 0.3, 0\n";  // room above the peak for the key
   for (std::size_t i = 0; i < methods.size(); ++i) {
-    std::vector<double> centres(kHistogramBins), counts(kHistogramBins, 0.0);
-    for (int b = 0; b < kHistogramBins; ++b) centres[b] = -limit + (b + 0.5) * width;
-    for (const double e : pitch ? methods[i].pitch_deg : methods[i].roll_deg) {
-      if (!std::isfinite(e)) continue;
-      counts[std::min(kHistogramBins - 1, static_cast<int>((e + limit) / width))] += 1.0;
-    }
-    const std::string name = std::string(what) + std::to_string(i);
-    AppendDatablock(&f.script, name, {centres, counts});
-    plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:2 w histeps lw 1.4 lc rgb '" +
-             methods[i].color + "' title " + GnuplotQuote(methods[i].label);
-    ++f.series;
+    f.script += HistogramPanel(methods[i], pitch ? methods[i].pitch_deg : methods[i].roll_deg,
+                               std::string(what) + std::to_string(i), &f);
   }
-  f.script += "plot " + plots + "\n";
-  f.caption = std::string("The ") + what + " error of every run (errors.csv) per method, " +
-              std::to_string(kHistogramBins) + " common bins over ± the largest error; non-finite errors left out.";
+  f.script += "unset multiplot\n";
+  f.caption = std::string("The ") + what + " error of every run (errors.csv), one panel per method: " +
+              std::to_string(kHistogramBins) +
+              " bins over ± the method's largest error, or ± 6 × its RMS when the tails are longer (the runs beyond "
+              "the axis are counted in the key); dashed: the normal density with the method's RMS. Non-finite "
+              "errors left out.";
   return f;
 }
 

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <stdexcept>
 
 #include "core/io/atomic_file.h"
+#include "core/io/folder.h"
 #include "core/io/input_error.h"
 #include "problems/report/alignment_pages.h"
 #include "problems/report/figures.h"
@@ -70,6 +72,26 @@ std::vector<AlignmentFolder> ReadFolders(const std::vector<std::string>& dirs, s
   return folders;
 }
 
+/// Writes the page and, with options.figures_dir, every figure's SVG; all or nothing.
+void WritePageFiles(const ReportOptions& options, const std::string& html, const std::vector<Figure>& figures) {
+  std::vector<std::unique_ptr<AtomicFile>> files;
+  files.push_back(std::make_unique<AtomicFile>(options.out_path));
+  files.back()->stream() << html;
+  if (!options.figures_dir.empty()) {
+    EnsureFolder(options.figures_dir);
+    for (const Figure& f : figures) {
+      files.push_back(std::make_unique<AtomicFile>(options.figures_dir + "/" + HtmlAnchor(f.id) + ".svg"));
+      files.back()->stream() << f.svg;
+    }
+  }
+  try {
+    for (auto& f : files) f->Commit();
+  } catch (...) {
+    for (auto& f : files) f->Revoke();
+    throw;
+  }
+}
+
 /// The page of transfer-align, inflight-align, level-mc or calibration folders.
 ReportSummary WriteAlignmentReport(const ReportOptions& options, const std::vector<AlignmentFolder>& folders,
                                    const std::string& kind) {
@@ -81,9 +103,7 @@ ReportSummary WriteAlignmentReport(const ReportOptions& options, const std::vect
     *options.progress << "report: drawing " << page.figures.figures.size() << " figures with gnuplot\n";
   }
   RenderFigures(&page.figures.figures, options.jobs);
-  AtomicFile out(options.out_path);
-  out.stream() << HtmlPage(page.text, page.figures.figures, page.figures.left_out);
-  out.Commit();
+  WritePageFiles(options, HtmlPage(page.text, page.figures.figures, page.figures.left_out), page.figures.figures);
   ReportSummary summary;
   summary.figures = page.figures.figures.size();
   summary.left_out = page.figures.left_out;
@@ -130,9 +150,7 @@ ReportSummary WriteReport(const ReportOptions& options) {
   }
   RenderFigures(&set.figures, options.jobs);
   if (options.progress) *options.progress << "report: drawn at " << elapsed_s() << " s\n";
-  AtomicFile out(options.out_path);
-  out.stream() << ReportHtml(runs, set.figures, set.left_out);
-  out.Commit();
+  WritePageFiles(options, ReportHtml(runs, set.figures, set.left_out), set.figures);
   ReportSummary summary;
   summary.figures = set.figures.size();
   summary.left_out = set.left_out;

@@ -12,6 +12,9 @@ namespace navtwin::report {
 struct ReportOptions {
   std::vector<std::string> run_dirs;
   std::string out_path;               ///< the HTML file, written whole or not at all
+  /// When set, every figure also as an SVG file <figures_dir>/<figure id>.svg (the folder
+  /// created if missing), written with the page: all or nothing.
+  std::string figures_dir;
   std::size_t max_points = 2000;      ///< per plotted series (the scores use every row)
   int jobs = 2;                       ///< files read and gnuplot processes run at once
   std::ostream* progress = nullptr;   ///< one line per step, when given

@@ -244,6 +244,62 @@ void TransferAttitudeFigure(const std::vector<TransferMethod>& methods, FigureSe
   out->figures.push_back(std::move(f));
 }
 
+/// Several folders that differ in the true delay (a sweep): per method the slave attitude
+/// RMS against the true delay, heading on top, roll and pitch below. Needs three folders
+/// and two distinct known delays.
+void TransferSweepFigure(const std::vector<AlignmentFolder>& folders, const std::vector<TransferMethod>& methods,
+                         FigureSet* out) {
+  std::vector<double> delays;
+  for (const TransferMethod& m : methods) {
+    if (std::isfinite(m.delay_true_s) && std::find(delays.begin(), delays.end(), m.delay_true_s) == delays.end()) {
+      delays.push_back(m.delay_true_s);
+    }
+  }
+  if (folders.size() < 3 || delays.size() < 2) return;
+  std::vector<std::string> names;
+  for (const TransferMethod& m : methods) {
+    if (std::find(names.begin(), names.end(), m.method) == names.end()) names.push_back(m.method);
+  }
+  Figure f;
+  f.id = "attitude_rms_vs_delay";
+  f.title = "Slave attitude RMS against the true delay";
+  f.height_px = 760;
+  const auto [lo, hi] = std::minmax_element(delays.begin(), delays.end());
+  const double pad_ms = 50.0 * (*hi - *lo);  // 5 % of the span, in ms
+  f.script = GnuplotCommon() + "set multiplot layout 2,1\nset lmargin 12\nset rmargin 24\nset logscale y\n" +
+             "set key outside right top\nset xrange [" + GnuplotNumber("%.9g", 1e3 * *lo - pad_ms) + ":" +
+             GnuplotNumber("%.9g", 1e3 * *hi + pad_ms) + "]\n";
+  std::string top, bottom;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    std::vector<std::array<double, 4>> rows;  // delay ms, roll, pitch, heading RMS (mrad)
+    for (const TransferMethod& m : methods) {
+      if (m.method != names[k] || !std::isfinite(m.delay_true_s)) continue;
+      rows.push_back({1e3 * m.delay_true_s, TransferNumber(m, "roll_rms_mrad"), TransferNumber(m, "pitch_rms_mrad"),
+                      TransferNumber(m, "heading_rms_mrad")});
+    }
+    std::sort(rows.begin(), rows.end());
+    std::vector<std::vector<double>> columns(4);
+    for (const auto& r : rows) {
+      columns[0].push_back(r[0]);
+      for (std::size_t c = 1; c < 4; ++c) columns[c].push_back(r[c] > 0.0 ? r[c] : std::nan(""));  // log scale
+    }
+    const std::string name = "s" + std::to_string(k), color = SeriesColor(k);
+    AppendDatablock(&f.script, name, columns);
+    top += (top.empty() ? "" : ", ") + std::string("$") + name + " u 1:4 w lp pt 7 lw 1.4 lc rgb '" + color +
+           "' title " + GnuplotQuote(names[k]);
+    bottom += (bottom.empty() ? "" : ", ") + std::string("$") + name + " u 1:2 w lp pt 7 lw 1.4 lc rgb '" + color +
+              "' title " + GnuplotQuote(names[k] + " roll") + ", $" + name + " u 1:3 w lp pt 5 dt 2 lw 1.4 lc rgb '" +
+              color + "' title " + GnuplotQuote(names[k] + " pitch");
+    f.series += 3;
+  }
+  f.script += "set ylabel 'heading RMS [mrad]'\nunset xlabel\nplot " + top + "\n";
+  f.script += "set ylabel 'roll, pitch RMS [mrad]'\nset xlabel 'true delay [ms]'\nplot " + bottom + "\nunset multiplot\n";
+  f.caption = "Each method's slave attitude RMS after the settling time (summary.json roll/pitch/heading_rms_mrad) in "
+              "every folder, against the folder's true delay (delay_true_s), log scale: how the methods degrade "
+              "with the delay.";
+  out->figures.push_back(std::move(f));
+}
+
 }  // namespace
 
 PageParts TransferPage(const std::vector<AlignmentFolder>& folders, std::size_t max_points) {
@@ -260,6 +316,7 @@ PageParts TransferPage(const std::vector<AlignmentFolder>& folders, std::size_t 
   page.figures.figures.push_back(TransferMisalignmentFigure(methods));
   page.figures.figures.push_back(TransferDelayFigure(methods));
   TransferAttitudeFigure(methods, &page.figures);
+  TransferSweepFigure(folders, methods, &page.figures);
   return page;
 }
 

@@ -95,8 +95,9 @@ TEST(InflightCliTest, OutWritesTheRunFolder) {
                               "/baro.csv --init_from " + d + "/init.nav --truth " + d +
                               "/truth.nav --method all --out " + out + " --report");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  // --report: the page with its two figures (heading error and sigma against distance).
-  EXPECT_EQ(Occurrences(ReadAll(out + "/report.html"), "data:image/svg+xml;base64,"), 2u);
+  // --report: the page with its three figures (heading error against distance, over the
+  // second half, and sigma against distance).
+  EXPECT_EQ(Occurrences(ReadAll(out + "/report.html"), "data:image/svg+xml;base64,"), 3u);
   const std::string summary = ReadAll(out + "/summary.json");
   EXPECT_EQ(summary.rfind("{\"command\":\"inflight-align\",\"methods\":{\"distance\":{", 0), 0u) << summary;
   for (const char* method : {"distance", "kalman", "batch"}) {

@@ -26,11 +26,12 @@ namespace {
 
 namespace check = report_page_check;
 
-std::string TransferMethodJson(const std::string& method) {
+std::string TransferMethodJson(const std::string& method, double delay_true_s = 0.3) {
   return "\"" + method + "\":{\"method\":\"" + method +
          "\",\"roll_rms_mrad\":0.5,\"pitch_rms_mrad\":0.4,\"heading_rms_mrad\":0.9,\"roll_max_mrad\":1.5,"
          "\"pitch_max_mrad\":1.2,\"heading_max_mrad\":2.5,\"delay_est_s\":0.2995,\"delay_sigma_s\":0.0002,"
-         "\"misalignment_deg\":[0.501,-0.299,0.802],\"run_time_s\":0.4,\"delay_true_s\":0.3,"
+         "\"misalignment_deg\":[0.501,-0.299,0.802],\"run_time_s\":0.4,\"delay_true_s\":" +
+         std::to_string(delay_true_s) + ","
          "\"misalignment_sigma_mrad\":[0.04,0.04,0.03],\"misalignment_true_deg\":[0.5,-0.3,0.8],"
          "\"misalignment_error_mrad\":0.04,\"epochs\":201,\"note\":\"scored against the slave truth\"}";
 }
@@ -75,14 +76,15 @@ std::string TrackCsv() {
 
 class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
  protected:
-  std::string TransferFolder(const std::string& name) {
+  std::string TransferFolder(const std::string& name, double delay_true_s = 0.3) {
     for (const char* m : {"order1", "batch"}) {
       std::filesystem::create_directories(dir_ + "/" + name + "/" + m);
       Write(name + "/" + m + "/estimates.csv", EstimatesCsv());
       Write(name + "/" + m + "/attitude_errors.csv", AttitudeErrorsCsv());
     }
-    Write(name + "/summary.json", "{\"command\":\"transfer-align\",\"methods\":{" + TransferMethodJson("order1") +
-                                      "," + TransferMethodJson("batch") + "}}\n");
+    Write(name + "/summary.json", "{\"command\":\"transfer-align\",\"methods\":{" +
+                                      TransferMethodJson("order1", delay_true_s) + "," +
+                                      TransferMethodJson("batch", delay_true_s) + "}}\n");
     return dir_ + "/" + name;
   }
   std::string InflightFolder(const std::string& name) {
@@ -159,10 +161,11 @@ class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
         file, {{"residuals.csv", [&](std::ostream& o) { calibration::WriteMagResidualsCsv(o, c, samples); }}});
     return dir_ + "/" + name;
   }
-  std::string Report(const std::vector<std::string>& dirs) {
+  std::string Report(const std::vector<std::string>& dirs, const std::string& figures_dir = "") {
     report::ReportOptions o;
     o.run_dirs = dirs;
     o.out_path = dir_ + "/report.html";
+    o.figures_dir = figures_dir;
     o.max_points = 100;
     report::WriteReport(o);
     std::ifstream in(o.out_path);
@@ -204,8 +207,9 @@ TEST_F(AlignmentReportTest, TransferFiguresAndTables) {
 
 TEST_F(AlignmentReportTest, InflightFiguresAndTables) {
   const std::string html = Report({InflightFolder("ia")});
-  ExpectFigures(html, {{"heading_error", 4},    // 2 methods x (band + error)
-                       {"heading_sigma", 2}});  // 2 methods
+  ExpectFigures(html, {{"heading_error", 4},              // 2 methods x (band + error)
+                       {"heading_error_second_half", 4},  // the same from 60 km on
+                       {"heading_sigma", 2}});            // 2 methods
   for (const char* text : {"100 km", "-2.000", "<td>0.45</td>", "0 of 121 GPS fixes rejected"}) {
     EXPECT_NE(html.find(text), std::string::npos) << text;
   }
@@ -288,7 +292,7 @@ TEST_F(AlignmentReportTest, ChromiumLoadsEveryTransferFigure) {
 // summary.json whose columns errors.csv lacks is an InputError naming the column.
 TEST_F(AlignmentReportTest, LevelingHistograms) {
   const std::string html = Report({LevelingFolder("lv")});
-  ExpectFigures(html, {{"pitch_histogram", 2}, {"roll_histogram", 2}});
+  ExpectFigures(html, {{"pitch_histogram", 4}, {"roll_histogram", 4}});  // histogram and normal curve per method
   for (const char* text : {"plain_mean", "pitch err/σ RMS", "<td>400</td>"}) {
     EXPECT_NE(html.find(text), std::string::npos) << text;
   }
@@ -317,6 +321,29 @@ TEST_F(AlignmentReportTest, CalibrationPagesShowResidualsBeforeAndAfter) {
   Write("cal_a/residuals.csv", "t0_s,t1_s,run,temperature_degC,rms\n0,1,0,nan,0\n");
   const std::string e = ReportError({imu}, dir_ + "/cal_bad.html");
   EXPECT_NE(e.find("accel_before_x_mg"), std::string::npos) << e;
+}
+
+// A delay sweep (three folders, distinct true delays) adds the attitude RMS against the true
+// delay, one series per method and axis; --figures_dir writes every figure as its SVG.
+TEST_F(AlignmentReportTest, DelaySweepFigureAndFigureFiles) {
+  const std::string figures = dir_ + "/figures";
+  const std::string html =
+      Report({TransferFolder("d100", 0.1), TransferFolder("d200", 0.2), TransferFolder("d300", 0.3)}, figures);
+  bool found = false;
+  for (const check::PageFigure& f : check::Figures(html)) {
+    std::ifstream in(figures + "/" + f.id + ".svg");
+    std::stringstream file;
+    file << in.rdbuf();
+    EXPECT_EQ(file.str(), f.bytes) << f.id;  // the page's drawing, byte for byte
+    if (f.id != "attitude_rms_vs_delay") continue;
+    found = true;
+    EXPECT_EQ(check::PlottedSeries(f.bytes), 6);  // 2 methods x (heading; roll, pitch)
+    EXPECT_NE(f.bytes.find("true delay [ms]"), std::string::npos);
+  }
+  EXPECT_TRUE(found);
+  EXPECT_EQ(check::Figures(html).size(), 4u);
+  // Two folders, or three with one delay, are no sweep.
+  EXPECT_EQ(check::Figures(Report({TransferFolder("a"), TransferFolder("b"), TransferFolder("c")})).size(), 3u);
 }
 
 }  // namespace
