@@ -153,6 +153,7 @@ std::string CheckFlags(const Options& opt, const Files& files) {
   }
   if (!smooth && !FLAGS_smoother.empty() && FLAGS_smoother != "rts") return "--smoother must be rts (or absent)";
   if (FLAGS_output_rate_hz < 0.0) return "--output_rate_hz must be >= 0";
+  if (!(FLAGS_std_rate_hz >= 0.0)) return "--std_rate_hz must be >= 0";
   if (FlagGiven("gate_probability") && !(FLAGS_gate_probability > 0.0 && FLAGS_gate_probability <= 1.0)) {
     return "--gate_probability must be in (0, 1] (1: no gate)";
   }
@@ -198,6 +199,7 @@ std::string ResolveConfig(const Options& opt, Files* files, GnssInsConfig* confi
     files->baro.clear();
   }
   if (FlagGiven("output_rate_hz")) config->output_rate_hz = FLAGS_output_rate_hz;
+  if (FlagGiven("std_rate_hz")) config->std_rate_hz = FLAGS_std_rate_hz;
   if (!FLAGS_init_from.empty()) {
     // The record is picked once the inputs are read (InitConfig::nav_file_at_start): without
     // --start_s, at the start of the IMU record on the reference's time scale.
@@ -293,13 +295,13 @@ int Run(const Options& opt, const std::vector<std::string>& args) {
 
 const char* const kNavigateUsage =
     "navtwin navigate --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
-    "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
+    "--out DIR [--smoother=rts] [--truth F] [--output_rate_hz R] [--std_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--init_from NAV] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--gate_probability P] [--strict] [--report] [--format=json]";
 const char* const kSmoothUsage =
     "navtwin smooth --imu F --gnss F [--mag F] [--baro F] (--config YAML | --kfgins_config YAML | --obgins_config YAML) "
-    "--out DIR [--truth F] [--output_rate_hz R] [--outage_start_s S --outage_len_s L "
+    "--out DIR [--truth F] [--output_rate_hz R] [--std_rate_hz R] [--outage_start_s S --outage_len_s L "
     "[--outage_period_s P]] [--start_s S] [--end_s S] [--init_from NAV] [--calibration FILE [--imu_temperature_degC T]] "
     "[--nhc [--nhc_sigma_mps S]] [--odometer F] [--vehicle_mounting_rpy_deg R,P,Y] [--vehicle_lever_arm_b_m X,Y,Z] "
     "[--gate_probability P] [--variance_components=false] [--strict] [--report] [--format=json]\n"
@@ -315,7 +317,7 @@ Command NavigateCommand() {
           "GNSS/INS/magnetometer error-state Kalman filter (and RTS smoother) over a record",
           kNavigateUsage,
           {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "smoother", "truth",
-           "output_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
+           "output_rate_hz", "std_rate_hz", "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s",
            "calibration", "imu_temperature_degC", "init_from", "nhc", "nhc_sigma_mps", "odometer", "vehicle_mounting_rpy_deg",
            "vehicle_lever_arm_b_m", "gate_probability", "strict", "report"},
           &RunNavigate};
@@ -325,7 +327,7 @@ Command SmoothCommand() {
   return {"smooth",
           "Filter, RTS and full-batch Ceres smoother over a record; prints the comparison table",
           kSmoothUsage,
-          {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "truth", "output_rate_hz",
+          {"imu", "gnss", "mag", "baro", "config", "kfgins_config", "obgins_config", "out", "truth", "output_rate_hz", "std_rate_hz",
            "outage_start_s", "outage_len_s", "outage_period_s", "start_s", "end_s", "demo", "seed",
            "demo_scenario", "demo_mag", "calibration", "imu_temperature_degC", "init_from", "nhc", "nhc_sigma_mps",
            "odometer", "vehicle_mounting_rpy_deg", "vehicle_lever_arm_b_m", "gate_probability",

@@ -51,6 +51,9 @@ DEFINE_double(start_s, NAN,
               "record, or the first IMU interval; level: seconds after the first IMU sample, default 0)");
 DEFINE_double(end_s, INFINITY, "Stop after this time, s");
 DEFINE_double(output_rate_hz, 0.0, "Solution output rate, Hz (0: every IMU epoch)");
+DEFINE_double(std_rate_hz, 1.0,
+              "navigate, smooth: rate of std.csv and imu_errors.csv among the output epochs, Hz (0: every output "
+              "epoch; default 1, or the configuration's std_rate_hz)");
 
 DEFINE_double(window_s, 0.2, "Leveling window length, s");
 DEFINE_double(noise_mg, 50.0,

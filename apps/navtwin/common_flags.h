@@ -36,6 +36,7 @@ DECLARE_double(imu_temperature_degC);
 DECLARE_double(start_s);
 DECLARE_double(end_s);
 DECLARE_double(output_rate_hz);
+DECLARE_double(std_rate_hz);
 
 // Leveling (level, level-mc).
 DECLARE_double(window_s);

@@ -274,18 +274,29 @@ void KfginsGnssWriter::Commit() { file_.Commit(); }
 
 KfginsNavWriter::KfginsNavWriter(const std::string& path) : file_(path) {}
 
-void KfginsNavWriter::Write(const NavState& s) {
+void AppendNavFields(const NavState& s, char separator, TextLine* line) {
   RequireFinite(s.t_s, "navigation time");
   RequireFinite(Eigen::Vector3d(s.lat_rad, s.lon_rad, s.h_m), "navigation position");
   RequireFinite(s.v_n_mps, "navigation velocity");
   RequireFinite(s.q_n_b.coeffs().head<3>(), "attitude quaternion");
   const Eigen::Vector3d euler_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
+  const double fields[10] = {s.t_s,         s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m,        s.v_n_mps.x(),
+                             s.v_n_mps.y(), s.v_n_mps.z(),         euler_deg.x(),         euler_deg.y(), euler_deg.z()};
+  line->Number(fields[0]);
+  for (int i = 1; i < 10; ++i) line->Char(separator).Number(fields[i]);
+}
+
+void KfginsNavWriter::Write(const NavState& s) {
   TextLine line;
-  line.Integer(s.gps_week < 0 ? 0 : s.gps_week).Char(' ').Number(s.t_s).Char(' ');
-  line.Number(s.lat_rad * kRadToDeg).Char(' ').Number(s.lon_rad * kRadToDeg).Char(' ');
-  line.Number(s.h_m);
-  AddTriple(line, s.v_n_mps);
-  AddTriple(line, euler_deg);
+  line.Integer(s.gps_week < 0 ? 0 : s.gps_week).Char(' ');
+  AppendNavFields(s, ' ', &line);
+  line.Char('\n').WriteTo(file_.stream());
+}
+
+void KfginsNavWriter::WriteFields(int gps_week, std::string_view comma_separated_fields) {
+  TextLine line;
+  line.Integer(gps_week < 0 ? 0 : gps_week).Char(' ');
+  for (const char c : comma_separated_fields) line.Char(c == ',' ? ' ' : c);
   line.Char('\n').WriteTo(file_.stream());
 }
 

@@ -17,9 +17,11 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/io/atomic_file.h"
+#include "core/io/text_line.h"
 #include "core/io/csv_odometer.h"
 #include "core/io/sample_reader.h"
 
@@ -59,12 +61,21 @@ class KfginsGnssWriter {
   int columns_ = 0;  ///< 0 until the first sample fixes 7 or 13
 };
 
+/// The navigation record's fields after the week, "t lat lon h vn ve vd roll pitch yaw" (s,
+/// deg, m, m/s, deg; attitude the ZYX Euler angles of q_n_b), each in the shortest form
+/// that reads back exactly, separated by `separator`. Throws std::invalid_argument for a
+/// non-finite state.
+void AppendNavFields(const NavState& s, char separator, TextLine* line);
+
 /// Writes the navigation format; gps_week = -1 (unknown) is written as week 0. Attitude
 /// as ZYX Euler angles (roll, pitch, yaw) of q_n_b in degrees.
 class KfginsNavWriter {
  public:
   explicit KfginsNavWriter(const std::string& path);
   void Write(const NavState& state);
+  /// Writes the record "week <fields>" from fields formatted by AppendNavFields with ','
+  /// (a writer of nav.csv formats each number once for both files).
+  void WriteFields(int gps_week, std::string_view comma_separated_fields);
   void Commit();
   void Revoke() { file_.Revoke(); }  ///< AtomicFile::Revoke
 

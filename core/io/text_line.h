@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <ostream>
 #include <stdexcept>
+#include <string_view>
 
 namespace navtwin {
 
@@ -25,6 +26,14 @@ class TextLine {
   TextLine& Char(char c) {
     Reserve(1);
     buf_[n_++] = c;
+    return *this;
+  }
+  /// What the line holds so far.
+  std::string_view view() const { return std::string_view(buf_, n_); }
+  /// Appends text as it is.
+  TextLine& Text(std::string_view text) {
+    Reserve(text.size());
+    for (const char c : text) buf_[n_++] = c;
     return *this;
   }
   /// Writes the line (with what it holds; add the '\n' yourself) and empties it.

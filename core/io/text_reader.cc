@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "core/io/input_error.h"
@@ -31,30 +32,53 @@ char LowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 
 
 LineReader::LineReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
   if (!in_) throw InputError(path, 0, "", "cannot open the file");
+  buf_.resize(std::size_t{1} << 20);
+}
+
+bool LineReader::Fill() {
+  pos_ = 0;
+  end_ = 0;
+  if (!in_) return false;
+  in_.read(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  end_ = static_cast<std::size_t>(in_.gcount());
+  return end_ > 0;
+}
+
+int LineReader::Peek() {
+  if (pos_ == end_ && !Fill()) return -1;
+  return static_cast<unsigned char>(buf_[pos_]);
 }
 
 bool LineReader::Next(std::string* line) {
   line->clear();
-  std::streambuf* buf = in_.rdbuf();
   line_end_ = LineEnd::kNone;
   bool any = false;
-  for (int c = buf->sbumpc(); c != std::char_traits<char>::eof(); c = buf->sbumpc()) {
+  while (pos_ < end_ || Fill()) {
     any = true;
-    ++offset_;
-    if (c == '\n') {
-      line_end_ = LineEnd::kLf;
-      break;
+    const char* begin = buf_.data() + pos_;
+    const std::size_t n = end_ - pos_;
+    // The first '\n', then a '\r' before it (never scanning past the line's end).
+    const char* lf = static_cast<const char*>(std::memchr(begin, '\n', n));
+    const std::size_t upto = lf ? static_cast<std::size_t>(lf - begin) : n;
+    const char* cr = static_cast<const char*>(std::memchr(begin, '\r', upto));
+    const char* stop = cr ? cr : lf;
+    if (!stop) {  // the line goes on in the next block
+      line->append(begin, n);
+      offset_ += n;
+      pos_ = end_;
+      continue;
     }
-    if (c == '\r') {
-      line_end_ = LineEnd::kCr;
-      if (buf->sgetc() == '\n') {
-        buf->sbumpc();
-        ++offset_;
-        line_end_ = LineEnd::kCrLf;
-      }
-      break;
+    const std::size_t length = static_cast<std::size_t>(stop - begin);
+    line->append(begin, length);
+    pos_ += length + 1;
+    offset_ += length + 1;
+    line_end_ = cr ? LineEnd::kCr : LineEnd::kLf;
+    if (cr && Peek() == '\n') {
+      ++pos_;
+      ++offset_;
+      line_end_ = LineEnd::kCrLf;
     }
-    line->push_back(static_cast<char>(c));
+    break;
   }
   if (!any) return false;
   ++line_number_;

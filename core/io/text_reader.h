@@ -37,8 +37,15 @@ class LineReader {
   const std::string& path() const { return path_; }
 
  private:
+  /// Refills buf_ from the file; false at its end.
+  bool Fill();
+  /// The next byte without taking it (-1 at the end of the file).
+  int Peek();
+
   std::string path_;
   std::ifstream in_;
+  std::vector<char> buf_;        ///< read in large blocks: the lines are found with memchr
+  std::size_t pos_ = 0, end_ = 0;  ///< unread bytes are buf_[pos_, end_)
   long line_number_ = 0;
   std::uint64_t offset_ = 0;
   LineEnd line_end_ = LineEnd::kNone;

@@ -581,13 +581,14 @@ void ObginsVehicle(const ConfigNode& root, GnssInsConfig* c) {
 GnssInsConfig LoadGnssInsConfig(const std::string& path, bool init_state_on_command_line) {
   const ConfigNode root = LoadYamlFile(path);
   root.RequireKeys({"imu_noise", "installation", "init", "mag", "baro", "zupt", "nhc", "odometer", "vehicle", "gnss",
-                    "outages", "filter", "batch", "output_rate_hz", "start_s", "end_s"});
+                    "outages", "filter", "batch", "output_rate_hz", "std_rate_hz", "start_s", "end_s"});
   if (!root.Has("imu_noise")) root.Fail("imu_noise", "required");
   GnssInsConfig c;
   c.start_time_s = root.Double("start_s", c.start_time_s);
   c.end_time_s = root.Double("end_s", c.end_time_s);
   if (!(c.end_time_s > c.start_time_s)) root.Fail("end_s", "must be after start_s");
   c.output_rate_hz = root.Double("output_rate_hz", 0.0, 0.0, 1e6);
+  c.std_rate_hz = root.Double("std_rate_hz", c.std_rate_hz, 0.0, 1e6);
   c.filter = ParseFilter(root.Child("filter"));
   c.imu_noise = ParseImuNoise(root.Child("imu_noise"), c.filter.scale_factors);
   c.installation = ParseInstallation(root.Child("installation"));

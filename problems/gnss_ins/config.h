@@ -129,6 +129,10 @@ struct GnssInsConfig {
   double start_time_s = -std::numeric_limits<double>::infinity();
   double end_time_s = std::numeric_limits<double>::infinity();
   double output_rate_hz = 0.0;  ///< 0: every IMU epoch
+  /// Rate of std.csv and imu_errors.csv among the output epochs (0: every output epoch):
+  /// a second's rows of σ and IMU errors change little, and at every 200 Hz epoch they were
+  /// most of the bytes a run wrote.
+  double std_rate_hz = 1.0;
   /// KF-GINS paths when the configuration came from a KF-GINS file (empty otherwise).
   std::string imu_path, gnss_path, output_path;
 };

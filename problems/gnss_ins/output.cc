@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 
@@ -45,12 +46,11 @@ void WriteStdCsvHeader(std::ostream& out, bool scale_factors) {
   out << '\n';
 }
 
+/// nav.csv's row: the navigation record's fields (kfgins.h AppendNavFields) comma separated.
 void WriteNavCsvRow(std::ostream& out, const NavState& s) {
-  const Eigen::Vector3d rpy_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
-  const double nav[9] = {s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m,
-                         s.v_n_mps.x(),         s.v_n_mps.y(),         s.v_n_mps.z(),
-                         rpy_deg.x(),           rpy_deg.y(),           rpy_deg.z()};
-  Row(out, s.t_s, nav, 9);
+  TextLine line;
+  AppendNavFields(s, ',', &line);
+  line.Char('\n').WriteTo(out);
 }
 
 /// Standard deviations in the units of the header; NaN where not computed.
@@ -66,6 +66,17 @@ void WriteStdCsvRow(std::ostream& out, const NavEpoch& epoch, bool scale_factors
     sd[i] = i < epoch.std.size() ? epoch.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
   }
   Row(out, epoch.state.nav.t_s, sd, n);
+}
+
+/// `to` as a hard link of `from` (replacing a file of that name), or a copy where the file
+/// system cannot link. Throws std::runtime_error when neither works.
+void LinkOrCopy(const std::string& from, const std::string& to) {
+  std::error_code ec;
+  std::filesystem::remove(to, ec);
+  std::filesystem::create_hard_link(from, to, ec);
+  if (!ec) return;
+  std::filesystem::copy_file(from, to, std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) throw std::runtime_error("cannot link or copy " + from + " to " + to + ": " + ec.message());
 }
 
 /// A folder for a method's files: created when missing (returns whether it was).
@@ -104,10 +115,14 @@ NavOutputWriter::NavOutputWriter(const std::string& dir, bool scale_factors)
   errors_.stream() << '\n';
 }
 
-void NavOutputWriter::Write(const NavEpoch& epoch) {
+void NavOutputWriter::Write(const NavEpoch& epoch, bool with_std) {
   const NavState& s = epoch.state.nav;
-  nav_.Write(s);  // checks the state is finite (std::invalid_argument otherwise)
-  WriteNavCsvRow(csv_.stream(), s);
+  TextLine fields;  // nav.csv's row, and nav.nav's record after the week: formatted once
+  AppendNavFields(s, ',', &fields);  // checks the state is finite (std::invalid_argument otherwise)
+  nav_.WriteFields(s.gps_week, fields.view());
+  fields.Char('\n').WriteTo(csv_.stream());
+  ++count_;
+  if (!with_std) return;
   WriteStdCsvRow(std_.stream(), epoch, scale_factors_);
 
   const ImuErrors& e = epoch.state.imu;
@@ -119,7 +134,6 @@ void NavOutputWriter::Write(const NavEpoch& epoch) {
     imu[9 + i] = e.sa[i] / kPpm;
   }
   Row(errors_.stream(), s.t_s, imu, scale_factors_ ? 12 : 6);
-  ++count_;
 }
 
 void NavOutputWriter::Commit() {
@@ -167,10 +181,17 @@ std::vector<AtomicFile*> MethodOutputWriter::Files() const {
   return files;
 }
 
-void MethodOutputWriter::Write(const NavEpoch& epoch) {
+void MethodOutputWriter::Write(const NavEpoch& epoch, bool with_std) {
+  if (shares_top_level_) throw std::logic_error("MethodOutputWriter: Write on a method sharing the top-level files");
   WriteNavCsvRow(nav_csv_->stream(), epoch.state.nav);
-  WriteStdCsvRow(std_csv_->stream(), epoch, scale_factors_);
+  if (with_std) WriteStdCsvRow(std_csv_->stream(), epoch, scale_factors_);
   ++count_;
+}
+
+void MethodOutputWriter::ShareTopLevelFiles() {
+  shares_top_level_ = true;
+  nav_csv_.reset();  // removes the temporaries
+  std_csv_.reset();
 }
 
 void MethodOutputWriter::OpenErrors(bool reference_std) {
@@ -217,10 +238,16 @@ void MethodOutputWriter::WriteResiduals(const std::vector<MeasurementResidual>& 
 void MethodOutputWriter::Commit() {
   for (AtomicFile* f : Files()) f->Commit();
   committed_ = true;
+  if (!shares_top_level_) return;
+  const std::string top = dir_.substr(0, dir_.find_last_of('/'));
+  for (const char* name : {"nav.csv", "std.csv"}) LinkOrCopy(top + "/" + name, dir_ + "/" + name);
 }
 
 void MethodOutputWriter::Revoke() {
   for (AtomicFile* f : Files()) f->Revoke();
+  if (shares_top_level_ && committed_) {
+    for (const char* name : {"/nav.csv", "/std.csv"}) std::remove((dir_ + name).c_str());
+  }
   committed_ = false;
   // Empty unless a file's temporary is still there; the destructor tries again after them.
   if (created_dir_) ::rmdir(dir_.c_str());

@@ -11,10 +11,13 @@
 //                   heading north; "nan" where the estimator computed none)
 //   imu_errors.csv  t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg
 //                   [,sg_x_ppm,sg_y_ppm,sg_z_ppm,sa_x_ppm,sa_y_ppm,sa_z_ppm]
+//                   (std.csv and imu_errors.csv at the output epochs the writer's caller
+//                   marks, by default one per second: GnssInsConfig::std_rate_hz)
 // The bracketed scale-factor columns appear when the writer is built with scale_factors.
 // Per method the run computed (filter, rts, batch, filter_adapted, rts_adapted), in the
 // folder <method>/ (MethodOutputWriter):
-//   nav.csv, std.csv  the columns above, at the same output epochs
+//   nav.csv, std.csv  the columns above, at the same output epochs (for the output method
+//                     hard links to the top-level files)
 //   residuals.csv     t_s,sensor,dof,chi2,rejected: one row per measurement of an estimator
 //                     with residuals of its own (filter, batch; MeasurementResidual in
 //                     solution.h); chi2 and dof "nan" / 0 for a sample counted without an
@@ -57,8 +60,9 @@ class NavOutputWriter {
  public:
   /// `dir` must exist. Throws std::runtime_error when a file cannot be opened.
   NavOutputWriter(const std::string& dir, bool scale_factors);
-  /// Appends one epoch (in time order) to the four files.
-  void Write(const NavEpoch& epoch);
+  /// Appends one epoch (in time order) to nav.nav and nav.csv and, with `with_std`, to
+  /// std.csv and imu_errors.csv.
+  void Write(const NavEpoch& epoch, bool with_std);
   /// Renames the four files into place.
   void Commit();
   /// Undoes a Commit (a later step of the run failed): removes the four files.
@@ -88,8 +92,13 @@ class MethodOutputWriter {
   MethodOutputWriter(const MethodOutputWriter&) = delete;
   MethodOutputWriter& operator=(const MethodOutputWriter&) = delete;
 
-  /// Appends one output epoch (in time order) to nav.csv and std.csv.
-  void Write(const NavEpoch& epoch);
+  /// Appends one output epoch (in time order) to nav.csv and, with `with_std`, std.csv.
+  void Write(const NavEpoch& epoch, bool with_std);
+  /// The method is the run's output method: its nav.csv and std.csv are the top level's
+  /// (<out_dir>/nav.csv, std.csv), which Commit() hard-links (copies where the file system
+  /// cannot link) instead of writing them twice; Write() is not called then. Commit the top
+  /// level's files first.
+  void ShareTopLevelFiles();
   /// Opens errors.csv; reference_std: with the reference-sigma columns (a GNSS reference).
   void OpenErrors(bool reference_std);
   /// Appends a compared epoch to errors.csv (OpenErrors first).
@@ -111,6 +120,7 @@ class MethodOutputWriter {
   bool reference_std_ = false;
   bool created_dir_ = false;
   bool committed_ = false;
+  bool shares_top_level_ = false;
   std::size_t count_ = 0;
   std::unique_ptr<AtomicFile> nav_csv_, std_csv_;
   std::unique_ptr<AtomicFile> errors_csv_, residuals_csv_;  ///< null until opened

@@ -66,15 +66,22 @@ struct RunSinks {
 
 /// The callback an estimator's states at every IMU epoch go to: all of them to the
 /// method's scorer (when there is one), so the score does not depend on the output rate,
-/// and the output epochs (OutputDecimator at config.output_rate_hz) to the method's folder
-/// and to `writer` (when not null: the method written at the top level).
-std::function<void(const NavEpoch&)> Feed(const MethodSinks& sinks, NavOutputWriter* writer, double output_rate_hz) {
-  return [scorer = sinks.scorer.get(), files = sinks.files, writer,
-          decimator = OutputDecimator(output_rate_hz)](const NavEpoch& e) mutable {
+/// and the output epochs (OutputDecimator at config.output_rate_hz; their σ and IMU errors
+/// at config.std_rate_hz) to `writer` when not null (the method written at the top level,
+/// whose folder then shares its files), else to the method's folder.
+std::function<void(const NavEpoch&)> Feed(const MethodSinks& sinks, NavOutputWriter* writer,
+                                          const GnssInsConfig& config) {
+  if (writer) sinks.files->ShareTopLevelFiles();
+  return [scorer = sinks.scorer.get(), files = sinks.files, writer, decimator = OutputDecimator(config.output_rate_hz),
+          std_decimator = OutputDecimator(config.std_rate_hz)](const NavEpoch& e) mutable {
     if (scorer) scorer->Add(e);
     if (!decimator.Take(e.state.nav.t_s)) return;
-    files->Write(e);
-    if (writer) writer->Write(e);
+    const bool with_std = std_decimator.Take(e.state.nav.t_s);
+    if (writer) {
+      writer->Write(e, with_std);
+    } else {
+      files->Write(e, with_std);
+    }
   };
 }
 
@@ -93,7 +100,7 @@ MethodRun Scored(const std::string& name, Solution solution, const MethodSinks& 
 MethodRun DensifyAndScore(const std::string& name, Solution knots, const RunSinks& run_sinks, NavOutputWriter* writer,
                           bool has_residuals) {
   const MethodSinks sinks = run_sinks.Open(name);
-  Densify(knots, run_sinks.inputs, Feed(sinks, writer, run_sinks.config.output_rate_hz));
+  Densify(knots, run_sinks.inputs, Feed(sinks, writer, run_sinks.config));
   return Scored(name, std::move(knots), sinks, has_residuals);
 }
 
@@ -109,7 +116,7 @@ void RunAdaptedFilter(const RunSinks& sinks, const FilterStart& start, GnssInsRu
   }
   const MethodSinks filter_sinks = sinks.Open("filter_adapted");
   FilterResult fr = RunFilter(sinks.inputs, adapted.config, start, true,
-                              Feed(filter_sinks, nullptr, adapted.config.output_rate_hz), options.progress);
+                              Feed(filter_sinks, nullptr, adapted.config), options.progress);
   run->methods.push_back(Scored("filter_adapted", std::move(fr.filter), filter_sinks, true));
   if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
   run->methods.push_back(DensifyAndScore("rts_adapted", std::move(*fr.rts), sinks, nullptr, false));
@@ -127,7 +134,7 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
   const FilterStart start = InitialFilterState(inputs, config, options.progress);
   const MethodSinks filter_sinks = sinks.Open("filter");
   FilterResult fr = RunFilter(inputs, config, start, run_rts,
-                              Feed(filter_sinks, run_rts ? nullptr : sinks.writer, config.output_rate_hz),
+                              Feed(filter_sinks, run_rts ? nullptr : sinks.writer, config),
                               options.progress);
   run->methods.push_back(Scored("filter", std::move(fr.filter), filter_sinks, true));
   run->output_method = "filter";
@@ -221,9 +228,9 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
   const std::string summary = options.out_dir + "/summary.json";
   WriteJsonFile(summary, [&](JsonWriter& w) { WriteRunSummary(w, options, run); });
   try {
+    writer.Commit();  // before the method folders: the output method's links to its files
     for (const auto& f : method_files) f->Commit();
     gnss_csv.Commit();
-    writer.Commit();
   } catch (...) {
     for (const auto& f : method_files) f->Revoke();
     gnss_csv.Revoke();

@@ -42,6 +42,31 @@ TEST(TextReaderTest, LineReaderHandlesLfCrLfAndCrEndsAndCountsBytes) {
   EXPECT_FALSE(r.Next(&line));
 }
 
+// The reader takes the file in 1 MiB blocks: a line longer than a block, and a CR LF whose
+// two bytes fall into two blocks, come out whole, with their byte offsets.
+TEST(TextReaderTest, LinesAcrossBlockBoundariesComeOutWhole) {
+  constexpr std::size_t kBlock = std::size_t{1} << 20;
+  const std::string longest(kBlock + 100, 'x');
+  const std::string first(kBlock - 2, 'y');  // "y...y\r" ends the first block, "\n" starts the next
+  const std::string text = first + "\r\n" + longest + "\nz\r";
+  LineReader r(WriteTempFile("blocks.txt", text));
+  std::string line;
+  ASSERT_TRUE(r.Next(&line));
+  EXPECT_EQ(line, first);
+  EXPECT_EQ(r.line_end(), LineEnd::kCrLf);
+  EXPECT_EQ(r.end_offset(), kBlock);
+  ASSERT_TRUE(r.Next(&line));
+  EXPECT_EQ(line, longest);
+  EXPECT_EQ(r.line_end(), LineEnd::kLf);
+  EXPECT_EQ(r.end_offset(), kBlock + longest.size() + 1);
+  ASSERT_TRUE(r.Next(&line));
+  EXPECT_EQ(line, "z");
+  EXPECT_EQ(r.line_end(), LineEnd::kCr);
+  EXPECT_EQ(r.end_offset(), text.size());
+  EXPECT_EQ(r.line_number(), 3);
+  EXPECT_FALSE(r.Next(&line));
+}
+
 TEST(TextReaderTest, MissingFileIsAnInputErrorNamingIt) {
   ExpectInputError([] { LineReader r("/nonexistent/navtwin.txt"); },
                    {"/nonexistent/navtwin.txt", "cannot open"});
