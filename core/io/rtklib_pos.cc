@@ -9,6 +9,7 @@
 #include "core/io/input_error.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
+#include "core/text.h"
 
 namespace navtwin {
 namespace {
@@ -254,8 +255,9 @@ class RtklibPosReader final : public GnssReader {
       sow = ParseDouble(fields_[1], path(), line, "tow");
       CheckWeek(week, line, "week");
       if (sow < 0.0 || sow >= kSecondsPerWeek) {
-        throw InputError(path(), line, "tow",
-                         "seconds of week " + std::string(fields_[1]) + " outside [0, 604800)");
+        throw InputError(
+            path(), line, "tow",
+            "seconds of week " + PrintableText(std::string(fields_[1])) + " outside [0, 604800)");
       }
     }
     if (EqualsNoCase(header_.time_system, "UTC")) sow += header_.leap_s;
@@ -296,7 +298,8 @@ class RtklibPosReader final : public GnssReader {
     }
     if (mo < 1 || mo > 12 || d < 1 || d > 31 ||
         !IsGregorianDate(static_cast<int>(y), static_cast<int>(mo), static_cast<int>(d))) {
-      throw InputError(path(), line, "date", "no such date: " + std::string(fields_[0]));
+      throw InputError(path(), line, "date",
+                       "no such date: " + PrintableText(std::string(fields_[0])));
     }
     if (hh < 0 || hh > 23 || mm < 0 || mm > 59 || ss < 0.0 || ss >= 61.0) {
       throw InputError(path(), line, "time", "no such time of day");
