@@ -479,7 +479,9 @@ FileSummary DescribeULog(const std::string& path) {
   summary.notes.push_back("ULog version " + std::to_string(log.version()));
   for (const char* key : {"sys_name", "ver_hw"}) {
     const auto it = log.info().find(key);
-    if (it != log.info().end()) summary.notes.push_back(std::string(key) + ": " + it->second);
+    if (it != log.info().end()) {
+      summary.notes.push_back(std::string(key) + ": " + PrintableText(it->second, 128));
+    }
   }
   for (const ULogSubscription& sub : log.subscriptions()) {
     std::vector<std::string> fields;

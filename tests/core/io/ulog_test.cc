@@ -424,7 +424,7 @@ TEST(ULogTest, CircularOrUndefinedFormatIsAnErrorEvenWithoutSubscription) {
   }
 }
 
-TEST(ULogTest, ErrorMessagesShowBinaryNamesEscapedAndShortened) {
+TEST(ULogTest, ErrorMessagesAndNotesShowBinaryTextEscapedAndShortened) {
   auto printable = [](const std::string& text) {
     return std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
   };
@@ -448,6 +448,14 @@ TEST(ULogTest, ErrorMessagesShowBinaryNamesEscapedAndShortened) {
     const InputError e = CatchInputError([&] { DescribeULog(w.Save("no_colon")); });
     EXPECT_TRUE(printable(e.what())) << e.what();
     EXPECT_LT(std::string(e.what()).size(), 600u) << e.what();
+  }
+  {  // info text shown by DescribeULog
+    ULogWriter w = ImuLog();
+    w.InfoText("sys_name", "PX4\x1b[31m\x01");
+    w.Data(0, ImuData(1'000'000, 0.f, 5000, -9.8f, 5000));
+    const FileSummary summary = DescribeULog(w.Save("binary_info"));
+    EXPECT_TRUE(HasNote(summary, "sys_name: PX4\\x1b[31m\\x01"));
+    for (const std::string& note : summary.notes) EXPECT_TRUE(printable(note)) << note;
   }
 }
 
