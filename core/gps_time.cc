@@ -32,6 +32,10 @@ std::int64_t FloorDivideInt64(std::int64_t a, std::int64_t b) { return a / b - (
 
 }  // namespace
 
+bool IsGregorianDate(int year, int month, int day) {
+  return month >= 1 && month <= 12 && day >= 1 && day <= DaysInGregorianMonth(year, month);
+}
+
 std::int64_t DaysSinceUnixEpoch(int year, int month, int day) {
   std::int64_t days = 0;
   for (int y = 1970; y < year; ++y) days += IsGregorianLeapYear(y) ? 366 : 365;

@@ -19,6 +19,10 @@ constexpr std::int64_t kGpsEpochUnix_s = 315964800;
 /// GPS - UTC since 2017-01-01 (IERS Bulletin C 52), the value of the table's last entry.
 constexpr int kGpsMinusUtcSince2017_s = 18;
 
+/// True when the date exists in the proleptic Gregorian calendar: month 1..12 and day
+/// 1..the length of that month (February 29 only in leap years).
+bool IsGregorianDate(int year, int month, int day);
+
 /// Days from 1970-01-01 to the given proleptic Gregorian date (negative before 1970).
 std::int64_t DaysSinceUnixEpoch(int year, int month, int day);
 

@@ -30,4 +30,22 @@ std::string MarkupEscaped(const std::string& text) {
   return out;
 }
 
+std::string PrintableText(const std::string& raw, std::size_t max_bytes) {
+  const std::size_t shown = raw.size() > max_bytes ? max_bytes : raw.size();
+  std::string out;
+  out.reserve(shown + 3);
+  for (std::size_t i = 0; i < shown; ++i) {
+    const unsigned char c = static_cast<unsigned char>(raw[i]);
+    if (c >= 0x20 && c < 0x7f && c != '\\') {
+      out += static_cast<char>(c);
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  if (shown < raw.size()) out += "...";
+  return out;
+}
+
 }  // namespace navtwin

@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "core/io/input_error.h"
 
@@ -192,12 +195,48 @@ void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3
   out << YAML::EndSeq;
 }
 
+void RequireUniqueKeys(const YAML::Node& root, const std::string& file) {
+  // Depth first in file order without recursion; a node reached again through an alias
+  // (same position in the text) is walked once.
+  std::vector<std::pair<YAML::Node, std::string>> pending = {{root, ""}};
+  std::set<int> walked;
+  while (!pending.empty()) {
+    const YAML::Node node = pending.back().first;
+    const std::string path = pending.back().second;
+    pending.pop_back();
+    if (!node.IsMap() && !node.IsSequence()) continue;
+    if (node.Mark().pos >= 0 && !walked.insert(node.Mark().pos).second) continue;
+    std::vector<std::pair<YAML::Node, std::string>> children;
+    if (node.IsSequence()) {
+      for (std::size_t i = 0; i < node.size(); ++i) {
+        children.emplace_back(node[i], path + "[" + std::to_string(i) + "]");
+      }
+    } else {
+      std::set<std::string> keys;
+      for (const auto& kv : node) {
+        const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string("?");
+        const std::string key_path = path.empty() ? key : path + "." + key;
+        if (kv.first.IsScalar() && !keys.insert(key).second) {
+          throw InputError(
+              file, kv.first.Mark().line + 1, key_path,
+              "repeated key (the mapping already has '" + key + "'; only one value may be given)");
+        }
+        children.emplace_back(kv.second, key_path);
+      }
+    }
+    pending.insert(pending.end(), children.rbegin(), children.rend());
+  }
+}
+
 ConfigNode ParseYaml(const std::string& text, const std::string& file) {
+  YAML::Node root;
   try {
-    return ConfigNode(YAML::Load(text), file, "");
+    root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw InputError(file, e.mark.line + 1, "", "YAML syntax: " + e.msg);
   }
+  RequireUniqueKeys(root, file);
+  return ConfigNode(root, file, "");
 }
 
 ConfigNode LoadYamlFile(const std::string& path) {

@@ -72,8 +72,14 @@ void EmitVector(YAML::Emitter& out, const std::string& key, const Eigen::Vector3
 void EmitMatrix(YAML::Emitter& out, const std::string& key, const Eigen::Matrix3d& m_si,
                 double per_unit = 1.0);
 
+/// Throws InputError naming `file`, the line and the key path (e.g. "imu.rate_hz") when a
+/// mapping anywhere under `root` repeats a key: yaml-cpp keeps both pairs and a lookup
+/// takes the first, so the second value would be ignored without a word. Every loader of
+/// a YAML or JSON input calls this (ParseYaml and LoadYamlFile do).
+void RequireUniqueKeys(const YAML::Node& root, const std::string& file);
+
 /// Parses YAML text (from a file or a built-in preset named `file`) into a root node;
-/// syntax errors become InputError with the line.
+/// syntax errors and repeated keys become InputError with the line.
 ConfigNode ParseYaml(const std::string& text, const std::string& file);
 ConfigNode LoadYamlFile(const std::string& path);
 

@@ -18,6 +18,11 @@ namespace navtwin {
 namespace {
 
 constexpr std::uint64_t kDotClockModulus = 1ULL << 32;  // SampleTimeFine is a uint32 (us)
+/// A SampleTimeFine step (modulo 2^32) longer than this many times the previous nonzero
+/// step is a corrupt clock value, not a gap or a wrap (a lost sample doubles the step).
+constexpr std::uint64_t kMaxDotStepRatio = 100;
+/// The same bound before any step is known: 100 x 1 s, the slowest DOT output rate.
+constexpr std::uint64_t kMaxFirstDotStep_us = 100'000'000;
 /// A repeated time tag is the lost-sample pattern only after an interval this many times
 /// longer than the one before it (the pattern leaves a double interval: ratio 2).
 constexpr double kLostSampleGapRatio = 1.5;
@@ -190,11 +195,32 @@ class DotRows {
       throw InputError(path(), csv_.line(), time_name_, "not a uint32 microsecond count");
     }
     const std::uint64_t ticks = static_cast<std::uint64_t>(raw);
-    // A drop by more than half the range is the counter wrapping, not time going back.
-    if (has_last_tick_ && ticks < last_tick_ && last_tick_ - ticks > kDotClockModulus / 2) ++wraps_;
+    if (has_last_tick_) CheckStep(ticks);
     last_tick_ = ticks;
     has_last_tick_ = true;
     return static_cast<double>(ticks + wraps_ * kDotClockModulus) * kMicrosecond_s;
+  }
+
+  /// The step from the previous SampleTimeFine: forward by about the sample interval,
+  /// across 2^32 when the counter wraps (previous value near 2^32, this one near 0). A
+  /// short step back is left to the time check; a step (modulo 2^32) far longer than the
+  /// previous one is an InputError: one corrupt value would otherwise pass for a wrap
+  /// and shift every later sample by 4295 s.
+  void CheckStep(std::uint64_t ticks) {
+    const std::uint64_t forward = (ticks + kDotClockModulus - last_tick_) % kDotClockModulus;
+    const std::uint64_t backward = (last_tick_ + kDotClockModulus - ticks) % kDotClockModulus;
+    const std::uint64_t limit =
+        last_step_ > 0 ? kMaxDotStepRatio * last_step_ : kMaxFirstDotStep_us;
+    if (forward <= limit) {
+      if (ticks < last_tick_) ++wraps_;
+      if (forward > 0) last_step_ = forward;
+      return;
+    }
+    if (backward <= limit && ticks < last_tick_) return;  // back: the time check reports it
+    throw InputError(path(), csv_.line(), time_name_,
+                     "clock jumps from " + std::to_string(last_tick_) + " to " +
+                         std::to_string(ticks) + " us: neither about one sample interval (" +
+                         std::to_string(last_step_) + " us before) nor a wrap at 2^32");
   }
 
   CsvRows csv_;
@@ -213,6 +239,7 @@ class DotRows {
   std::uint64_t last_tick_ = 0;
   bool has_last_tick_ = false;
   std::uint64_t wraps_ = 0;
+  std::uint64_t last_step_ = 0;  ///< last nonzero SampleTimeFine step, 0 before the first
   IncreasingTime time_;
 };
 

@@ -5,9 +5,11 @@
 #include <string_view>
 #include <vector>
 
+#include "core/gps_time.h"
 #include "core/io/input_error.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
+#include "core/text.h"
 
 namespace navtwin {
 namespace {
@@ -15,6 +17,13 @@ namespace {
 // Whole seconds (integer arithmetic on GPS time).
 constexpr std::int64_t kDayWhole_s = static_cast<std::int64_t>(kSecondsPerDay);
 constexpr std::int64_t kWeekWhole_s = static_cast<std::int64_t>(kSecondsPerWeek);
+// Plausible GPS times: weeks from the GPS epoch (1980-01-06) to week 10000 (in 2171),
+// so that week arithmetic stays far from overflow; calendar years of that span.
+constexpr long long kMaxGpsWeek = 10000;
+constexpr long long kFirstGpsYear = 1980;
+constexpr long long kLastGpsYear = 2171;
+// GPS - UTC was 18 s from 2017; far more is a typing error.
+constexpr long long kMaxLeapSeconds = 100;
 
 std::int64_t FloorDiv(std::int64_t a, std::int64_t b) {
   std::int64_t q = a / b;
@@ -35,20 +44,32 @@ struct PosHeader {
   long column_line = 0;
 };
 
-/// "% ... leap seconds: 18" (any '%' line naming "leap" and then an integer).
-bool FindLeapSeconds(std::string_view line, int* leap_s) {
+bool IsDigit(char c) { return c >= '0' && c <= '9'; }
+
+/// "% ... leap seconds: 18" (any '%' line naming "leap" and then an integer): the text of
+/// that integer with its sign, empty when the line has none.
+std::string_view FindLeapSecondsText(std::string_view line) {
   for (std::size_t i = 0; i + 4 <= line.size(); ++i) {
     if (!EqualsNoCase(line.substr(i, 4), "leap")) continue;
     for (std::size_t j = i + 4; j < line.size(); ++j) {
-      if (line[j] >= '0' && line[j] <= '9') {
-        int v = 0;
-        while (j < line.size() && line[j] >= '0' && line[j] <= '9') v = v * 10 + (line[j++] - '0');
-        *leap_s = v;
-        return true;
-      }
+      if (!IsDigit(line[j])) continue;
+      const std::size_t start = line[j - 1] == '-' || line[j - 1] == '+' ? j - 1 : j;
+      while (j < line.size() && IsDigit(line[j])) ++j;
+      return line.substr(start, j - start);
     }
   }
-  return false;
+  return {};
+}
+
+/// GPS - UTC in seconds from the header's text; InputError unless 0..kMaxLeapSeconds.
+int ParseLeapSeconds(std::string_view text, const std::string& path, long line) {
+  const long long leap_s = ParseInteger(text, path, line, "leap seconds");
+  if (leap_s < 0 || leap_s > kMaxLeapSeconds) {
+    throw InputError(
+        path, line, "leap seconds",
+        "GPS - UTC must be 0.." + std::to_string(kMaxLeapSeconds) + " s, got " + std::string(text));
+  }
+  return static_cast<int>(leap_s);
 }
 
 void ParseColumnLine(const std::vector<std::string_view>& tokens, const std::string& path,
@@ -138,10 +159,10 @@ class RtklibPosReader final : public GnssReader {
         have_line_ = true;
         break;
       }
-      int leap = 0;
-      if (FindLeapSeconds(t, &leap)) {
+      const std::string_view leap_text = FindLeapSecondsText(t);
+      if (!leap_text.empty()) {
         header_.has_leap = true;
-        header_.leap_s = leap;
+        header_.leap_s = ParseLeapSeconds(leap_text, path(), lines_.line_number());
       }
       SplitLoose(t.substr(1), &fields_);
       if (!fields_.empty() && IsColumnLine(fields_)) {
@@ -232,9 +253,18 @@ class RtklibPosReader final : public GnssReader {
     } else {
       week = ParseInteger(fields_[0], path(), line, "week");
       sow = ParseDouble(fields_[1], path(), line, "tow");
+      CheckWeek(week, line, "week");
+      if (sow < 0.0 || sow >= kSecondsPerWeek) {
+        throw InputError(
+            path(), line, "tow",
+            "seconds of week " + PrintableText(std::string(fields_[1])) + " outside [0, 604800)");
+      }
     }
     if (EqualsNoCase(header_.time_system, "UTC")) sow += header_.leap_s;
-    if (first_week_ < 0) first_week_ = week;
+    if (!has_first_week_) {
+      first_week_ = week;
+      has_first_week_ = true;
+    }
     s->gps_week = static_cast<int>(first_week_);
     s->t_s = static_cast<double>((week - first_week_) * kWeekWhole_s) + sow;
     time_.Check(s->t_s, path(), line, "time");
@@ -261,8 +291,16 @@ class RtklibPosReader final : public GnssReader {
     const long long hh = ParseInteger(parts[0], path(), line, "time");
     const long long mm = ParseInteger(parts[1], path(), line, "time");
     const double ss = ParseDouble(parts[2], path(), line, "time");
-    if (mo < 1 || mo > 12 || d < 1 || d > 31)
-      throw InputError(path(), line, "date", "no such date");
+    if (y < kFirstGpsYear || y > kLastGpsYear) {
+      throw InputError(path(), line, "date",
+                       "year " + std::to_string(y) + " outside the GPS years " +
+                           std::to_string(kFirstGpsYear) + ".." + std::to_string(kLastGpsYear));
+    }
+    if (mo < 1 || mo > 12 || d < 1 || d > 31 ||
+        !IsGregorianDate(static_cast<int>(y), static_cast<int>(mo), static_cast<int>(d))) {
+      throw InputError(path(), line, "date",
+                       "no such date: " + PrintableText(std::string(fields_[0])));
+    }
     if (hh < 0 || hh > 23 || mm < 0 || mm > 59 || ss < 0.0 || ss >= 61.0) {
       throw InputError(path(), line, "time", "no such time of day");
     }
@@ -270,7 +308,17 @@ class RtklibPosReader final : public GnssReader {
         DaysFromCivil(static_cast<int>(y), static_cast<int>(mo), static_cast<int>(d)) -
         DaysFromCivil(1980, 1, 6);
     *week = FloorDiv(days, 7);
+    CheckWeek(*week, line, "date");
     *sow = static_cast<double>((days - *week * 7) * kDayWhole_s + hh * 3600 + mm * 60) + ss;
+  }
+
+  /// InputError unless 0 <= week <= kMaxGpsWeek.
+  void CheckWeek(long long week, long line, const char* field) const {
+    if (week < 0 || week > kMaxGpsWeek) {
+      throw InputError(path(), line, field,
+                       "GPS week " + std::to_string(week) + " outside 0.." +
+                           std::to_string(kMaxGpsWeek) + " (1980-01-06 to 2171)");
+    }
   }
 
   LineReader lines_;
@@ -279,7 +327,8 @@ class RtklibPosReader final : public GnssReader {
   std::string line_;
   std::vector<std::string_view> fields_;
   bool have_line_ = false;
-  std::int64_t first_week_ = -1;
+  std::int64_t first_week_ = 0;
+  bool has_first_week_ = false;
   IncreasingTime time_;
 };
 

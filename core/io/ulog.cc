@@ -12,6 +12,7 @@
 #include "core/io/ulog_time.h"
 #include "core/io/ulog_topic.h"
 #include "core/rotation.h"
+#include "core/text.h"
 #include "core/units.h"
 
 namespace navtwin {
@@ -51,7 +52,8 @@ class ULogFile::Impl {
   const ulog::Leaf& FindLeaf(const std::string& field) const;
   const std::uint8_t* data() const { return message_.payload.data() + 2; }
   InputError Error(const std::string& field, const std::string& reason) const {
-    return InputError::AtByte(stream_.path(), message_.byte_offset, field, reason);
+    return InputError::AtByte(stream_.path(), message_.byte_offset, PrintableText(field, 128),
+                              reason);
   }
 
   // One subscription's byte layout, parallel to subscriptions_.
@@ -76,8 +78,10 @@ class ULogFile::Impl {
   double dropout_total_s_ = 0.0;
   std::vector<long long> appended_offsets_;
   std::size_t unknown_messages_ = 0;
+  std::map<std::string, std::size_t> format_sizes_;  // of the formats checked so far
 
  private:
+  void CheckFormats();
   bool Handle();  // true for a data message, which becomes the current one
   void RequireSize(std::size_t min_size, const char* what) const;
   ulog::TypedName ParseKey(std::size_t key_len_at, std::size_t* value_at) const;
@@ -108,7 +112,19 @@ bool ULogFile::Impl::Next(const std::string* topic, int multi_id) {
     if (topic == nullptr || (sub.topic == *topic && sub.multi_id == multi_id)) return true;
   }
   has_current_ = false;
+  CheckFormats();  // a log with no subscription at all
   return false;
+}
+
+// Every format defined so far must resolve, subscribed or not (docs/formats.md). Checked
+// before each subscription (the definitions precede the first one) and at the end.
+void ULogFile::Impl::CheckFormats() {
+  if (format_sizes_.size() == formats_.size()) return;
+  for (const auto& entry : formats_) {
+    if (format_sizes_.count(entry.first) == 0) {
+      ulog::CheckFormat(entry.first, formats_, stream_.path(), &format_sizes_);
+    }
+  }
 }
 
 bool ULogFile::Impl::Handle() {
@@ -166,7 +182,7 @@ void ULogFile::Impl::HandleFormat() {
   ulog::Format format = ulog::ParseFormat(text, stream_.path(), message_.byte_offset);
   const std::string name = format.name;
   if (!formats_.emplace(name, std::move(format)).second) {
-    throw Error(name, "format '" + name + "' is defined twice");
+    throw Error(name, "format '" + PrintableText(name) + "' is defined twice");
   }
 }
 
@@ -191,15 +207,16 @@ ulog::TypedName ULogFile::Impl::ParseKey(std::size_t key_len_at, std::size_t* va
 std::string ULogFile::Impl::ValueText(const ulog::TypedName& key, std::size_t value_at) const {
   BaseType type;
   if (!ulog::ParseBaseType(key.type, &type)) {
-    throw Error(key.name, "type '" + key.type + "' is not a basic type");
+    throw Error(key.name, "type '" + PrintableText(key.type) + "' is not a basic type");
   }
   const std::size_t count = key.array_length > 0 ? static_cast<std::size_t>(key.array_length) : 1;
   const std::size_t value_size = message_.payload.size() - value_at;
   const std::uint8_t* value = message_.payload.data() + value_at;
   if (type == BaseType::kChar) return CString(value, value_size);
   if (value_size != count * ulog::BaseTypeSize(type)) {
-    throw Error(key.name, "value has " + std::to_string(value_size) + " bytes, type '" + key.type +
-                              "' needs " + std::to_string(count * ulog::BaseTypeSize(type)));
+    throw Error(key.name, "value has " + std::to_string(value_size) + " bytes, type '" +
+                              PrintableText(key.type) + "' needs " +
+                              std::to_string(count * ulog::BaseTypeSize(type)));
   }
   std::string text;
   for (std::size_t i = 0; i < count; ++i) {
@@ -219,7 +236,8 @@ void ULogFile::Impl::HandleParameter() {
   std::size_t value_at = 0;
   const ulog::TypedName key = ParseKey(0, &value_at);
   if ((key.type != "int32_t" && key.type != "float") || key.array_length != 0) {
-    throw Error(key.name, "parameter type must be int32_t or float, got '" + key.type + "'");
+    throw Error(key.name,
+                "parameter type must be int32_t or float, got '" + PrintableText(key.type) + "'");
   }
   if (message_.payload.size() - value_at != 4) {
     throw Error(key.name, "value has " + std::to_string(message_.payload.size() - value_at) +
@@ -230,14 +248,15 @@ void ULogFile::Impl::HandleParameter() {
 }
 
 void ULogFile::Impl::HandleSubscription() {
+  CheckFormats();
   RequireSize(4, "subscription");
   ULogSubscription sub;
   sub.multi_id = message_.payload[0];
   sub.msg_id = static_cast<int>(ulog::DecodeUnsigned(message_.payload.data() + 1, 2));
   sub.topic.assign(message_.payload.begin() + 3, message_.payload.end());
   if (formats_.count(sub.topic) == 0) {
-    throw Error("message_name",
-                "subscription to unknown format '" + sub.topic + "' (no 'F' message defines it)");
+    throw Error("message_name", "subscription to unknown format '" + PrintableText(sub.topic) +
+                                    "' (no 'F' message defines it)");
   }
   if (active_.count(sub.msg_id) != 0) {
     throw Error("msg_id", "msg_id " + std::to_string(sub.msg_id) + " is already subscribed");
@@ -278,8 +297,9 @@ void ULogFile::Impl::HandleData() {
   if (size < layout.min_size || size > layout.size) {
     throw Error(subscriptions_[it->second].Label(),
                 "data has " + std::to_string(size) + " bytes, format '" +
-                    subscriptions_[it->second].topic + "' has " + std::to_string(layout.size) +
-                    " (" + std::to_string(layout.min_size) + " without trailing padding)");
+                    PrintableText(subscriptions_[it->second].topic) + "' has " +
+                    std::to_string(layout.size) + " (" + std::to_string(layout.min_size) +
+                    " without trailing padding)");
   }
   current_ = it->second;
   has_current_ = true;
@@ -309,7 +329,7 @@ const ulog::Leaf& ULogFile::Impl::FindLeaf(const std::string& field) const {
   const auto it = layout.leaf_index.find(field);
   if (it == layout.leaf_index.end()) {
     throw Error(subscriptions_[current_].topic + "." + field,
-                "no such field in format '" + subscriptions_[current_].topic + "'");
+                "no such field in format '" + PrintableText(subscriptions_[current_].topic) + "'");
   }
   return layout.layout.leaves[it->second];
 }
@@ -459,7 +479,9 @@ FileSummary DescribeULog(const std::string& path) {
   summary.notes.push_back("ULog version " + std::to_string(log.version()));
   for (const char* key : {"sys_name", "ver_hw"}) {
     const auto it = log.info().find(key);
-    if (it != log.info().end()) summary.notes.push_back(std::string(key) + ": " + it->second);
+    if (it != log.info().end()) {
+      summary.notes.push_back(std::string(key) + ": " + PrintableText(it->second, 128));
+    }
   }
   for (const ULogSubscription& sub : log.subscriptions()) {
     std::vector<std::string> fields;

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/io/input_error.h"
+#include "core/text.h"
 
 namespace navtwin::ulog {
 namespace {
@@ -14,6 +15,8 @@ constexpr std::uint8_t kMagic[7] = {'U', 'L', 'o', 'g', 0x01, 0x12, 0x35};
 constexpr std::size_t kStreamBufferBytes = 1 << 16;
 // Nested formats deeper than this are treated as circular (real logs nest 2-3 levels).
 constexpr std::size_t kMaxNesting = 32;
+// A data message holds at most 65535 bytes, so no loggable format is larger.
+constexpr std::size_t kMaxFormatBytes = 65535;
 
 struct BaseTypeInfo {
   const char* name;
@@ -49,11 +52,65 @@ std::int64_t SignExtend(std::uint64_t u, std::size_t n) {
   return static_cast<std::int64_t>(u ^ sign) - static_cast<std::int64_t>(sign);
 }
 
+// The format that field `field` of `format` nests; throws at the 'F' message of `format`
+// when the type is not defined or the nesting is circular (`stack`: formats being resolved).
+const Format& NestedFormat(const Format& format, const TypedName& field,
+                           const std::map<std::string, Format>& formats, const std::string& file,
+                           const std::vector<std::string>& stack) {
+  const std::string where = PrintableText(format.name) + "." + PrintableText(field.name);
+  const auto nested = formats.find(field.type);
+  if (nested == formats.end()) {
+    throw InputError::AtByte(file, format.byte_offset, where,
+                             "unknown type '" + PrintableText(field.type) +
+                                 "' (neither a basic type nor a defined format)");
+  }
+  if (stack.size() >= kMaxNesting ||
+      std::find(stack.begin(), stack.end(), field.type) != stack.end()) {
+    throw InputError::AtByte(file, format.byte_offset, where,
+                             "circular nesting of format '" + PrintableText(field.type) + "'");
+  }
+  return nested->second;
+}
+
+// The size in bytes of `format` with its nested formats resolved, without expanding them;
+// sizes already known are in *sizes, which gets this one. Throws at the 'F' message of
+// the first format found larger than a data message can hold.
+std::size_t ResolvedSize(const Format& format, const std::map<std::string, Format>& formats,
+                         const std::string& file, std::vector<std::string>* stack,
+                         std::map<std::string, std::size_t>* sizes) {
+  const auto known = sizes->find(format.name);
+  if (known != sizes->end()) return known->second;
+  std::size_t total = 0;
+  for (const TypedName& field : format.fields) {
+    BaseType type;
+    std::size_t element = 0;
+    if (ParseBaseType(field.type, &type)) {
+      element = BaseTypeSize(type);
+    } else {
+      const Format& nested = NestedFormat(format, field, formats, file, *stack);
+      stack->push_back(field.type);
+      element = ResolvedSize(nested, formats, file, stack, sizes);
+      stack->pop_back();
+    }
+    const std::size_t count =
+        field.array_length > 0 ? static_cast<std::size_t>(field.array_length) : 1;
+    // total <= kMaxFormatBytes here, so the bound below cannot overflow.
+    if (element > (kMaxFormatBytes - total) / count) {
+      throw InputError::AtByte(
+          file, format.byte_offset, PrintableText(format.name) + "." + PrintableText(field.name),
+          "format '" + PrintableText(format.name) + "' is larger than " +
+              std::to_string(kMaxFormatBytes) + " bytes (the most a data message holds)");
+    }
+    total += element * count;
+  }
+  sizes->emplace(format.name, total);
+  return total;
+}
+
 // Appends the leaves of `format` (prefix e.g. "esc[1].") at byte `base` to *leaves and
-// returns the format's size in bytes.
+// returns the format's size in bytes. The format has been checked by ResolvedSize.
 std::size_t FlattenInto(const Format& format, const std::string& prefix, std::size_t base,
-                        const std::map<std::string, Format>& formats, const std::string& file,
-                        std::vector<std::string>* stack, std::vector<Leaf>* leaves) {
+                        const std::map<std::string, Format>& formats, std::vector<Leaf>* leaves) {
   std::size_t offset = 0;
   for (const TypedName& field : format.fields) {
     const std::size_t count =
@@ -65,27 +122,14 @@ std::size_t FlattenInto(const Format& format, const std::string& prefix, std::si
       offset += count * BaseTypeSize(type);
       continue;
     }
-    const auto nested = formats.find(field.type);
-    const std::string where = format.name + "." + field.name;
-    if (nested == formats.end()) {
-      throw InputError::AtByte(
-          file, format.byte_offset, where,
-          "unknown type '" + field.type + "' (neither a basic type nor a defined format)");
-    }
-    if (stack->size() >= kMaxNesting ||
-        std::find(stack->begin(), stack->end(), field.type) != stack->end()) {
-      throw InputError::AtByte(file, format.byte_offset, where,
-                               "circular nesting of format '" + field.type + "'");
-    }
-    stack->push_back(field.type);
+    const Format& nested = formats.at(field.type);
     std::vector<Leaf> scratch;  // leaves of a nested padding field are dropped
     for (std::size_t i = 0; i < count; ++i) {
       std::string nested_prefix = prefix + field.name;
       if (field.array_length > 0) nested_prefix += "[" + std::to_string(i) + "]";
-      offset += FlattenInto(nested->second, nested_prefix + ".", base + offset, formats, file,
-                            stack, keep ? leaves : &scratch);
+      offset += FlattenInto(nested, nested_prefix + ".", base + offset, formats,
+                            keep ? leaves : &scratch);
     }
-    stack->pop_back();
   }
   return offset;
 }
@@ -140,12 +184,12 @@ bool ParseTypedName(const std::string& text, TypedName* out, std::string* reason
                     bool allow_empty_array) {
   const std::size_t space = text.find(' ');
   if (space == std::string::npos || space == 0 || space + 1 == text.size()) {
-    *reason = "expected 'type name', got '" + text + "'";
+    *reason = "expected 'type name', got '" + PrintableText(text) + "'";
     return false;
   }
   out->name = text.substr(space + 1);
   if (!std::all_of(out->name.begin(), out->name.end(), IsNameChar)) {
-    *reason = "bad field name '" + out->name + "'";
+    *reason = "bad field name '" + PrintableText(out->name) + "'";
     return false;
   }
   std::string type = text.substr(0, space);
@@ -156,14 +200,14 @@ bool ParseTypedName(const std::string& text, TypedName* out, std::string* reason
     if (type.back() != ']' || digits.empty() || digits.size() > 5 ||
         !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
         (std::stoi(digits) == 0 && !allow_empty_array)) {
-      *reason = "bad array type '" + type + "'";
+      *reason = "bad array type '" + PrintableText(type) + "'";
       return false;
     }
     out->array_length = std::stoi(digits);
     type.resize(open);
   }
   if (type.empty() || !std::all_of(type.begin(), type.end(), IsNameChar)) {
-    *reason = "bad type '" + text.substr(0, space) + "'";
+    *reason = "bad type '" + PrintableText(text.substr(0, space)) + "'";
     return false;
   }
   out->type = type;
@@ -176,7 +220,7 @@ Format ParseFormat(const std::string& text, const std::string& file, long long b
   const std::size_t colon = text.find(':');
   if (colon == std::string::npos || colon == 0) {
     throw InputError::AtByte(file, byte_offset, "format",
-                             "expected 'name:type field;...', got '" + text + "'");
+                             "expected 'name:type field;...', got '" + PrintableText(text) + "'");
   }
   format.name = text.substr(0, colon);
   std::size_t start = colon + 1;
@@ -187,26 +231,34 @@ Format ParseFormat(const std::string& text, const std::string& file, long long b
       TypedName field;
       std::string reason;
       if (!ParseTypedName(text.substr(start, end - start), &field, &reason)) {
-        throw InputError::AtByte(file, byte_offset,
-                                 format.name + " field " + std::to_string(format.fields.size() + 1),
-                                 reason);
+        throw InputError::AtByte(
+            file, byte_offset,
+            PrintableText(format.name) + " field " + std::to_string(format.fields.size() + 1),
+            reason);
       }
       format.fields.push_back(field);
     }
     start = end + 1;
   }
   if (format.fields.empty()) {
-    throw InputError::AtByte(file, byte_offset, format.name, "format has no fields");
+    throw InputError::AtByte(file, byte_offset, PrintableText(format.name), "format has no fields");
   }
   return format;
 }
 
+std::size_t CheckFormat(const std::string& name, const std::map<std::string, Format>& formats,
+                        const std::string& file, std::map<std::string, std::size_t>* sizes) {
+  std::vector<std::string> stack = {name};
+  return ResolvedSize(formats.at(name), formats, file, &stack, sizes);
+}
+
 Layout Flatten(const std::string& name, const std::map<std::string, Format>& formats,
                const std::string& file) {
+  std::map<std::string, std::size_t> sizes;
+  CheckFormat(name, formats, file, &sizes);
   const Format& format = formats.at(name);
   Layout layout;
-  std::vector<std::string> stack = {name};
-  layout.size = FlattenInto(format, "", 0, formats, file, &stack, &layout.leaves);
+  layout.size = FlattenInto(format, "", 0, formats, &layout.leaves);
   layout.min_size = layout.size;
   const TypedName& last = format.fields.back();
   BaseType type;

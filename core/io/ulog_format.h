@@ -75,8 +75,14 @@ struct Layout {
   std::size_t min_size = 0;  ///< size without a trailing top-level padding field, which
                              ///< the logger may leave out of data messages
 };
-/// Flattens format `name`; throws InputError at the offending 'F' message for an
-/// unknown field type or circular nesting.
+/// Checks format `name` without expanding it: every nested type defined, no circular
+/// nesting, a size (bytes, nested arrays multiplied out) no larger than the 65535 bytes
+/// of a data message. Returns that size; *sizes keeps the sizes of the formats checked
+/// so far (pass the same map to check many formats in linear time). Throws InputError
+/// at the offending 'F' message.
+std::size_t CheckFormat(const std::string& name, const std::map<std::string, Format>& formats,
+                        const std::string& file, std::map<std::string, std::size_t>* sizes);
+/// Flattens format `name` after CheckFormat (whose InputErrors it throws).
 Layout Flatten(const std::string& name, const std::map<std::string, Format>& formats,
                const std::string& file);
 

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 
+#include "core/config/yaml_config.h"
 #include "core/rotation.h"
 #include "core/units.h"
 
@@ -70,6 +71,7 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
        "  attitude_std_deg: [2, 2, 5]\n";
   if (mag_mode != "off") {
     const YAML::Node errors = YAML::LoadFile(sim_dir + "/errors.yaml");
+    RequireUniqueKeys(errors, sim_dir + "/errors.yaml");
     const YAML::Node mag = errors["mag"];
     if (!mag) throw std::runtime_error(sim_dir + "/errors.yaml has no mag section");
     const YAML::Node soft = mag["soft_iron"];

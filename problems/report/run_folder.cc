@@ -10,6 +10,7 @@
 #include <set>
 #include <thread>
 
+#include "core/config/yaml_config.h"
 #include "core/io/input_error.h"
 #include "problems/report/csv_table.h"
 #include "problems/report/decimate.h"
@@ -39,6 +40,7 @@ YAML::Node ReadSummaryJson(const std::string& dir, const std::string& path) {
   } catch (const YAML::Exception& e) {
     throw InputError(path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "", "malformed JSON: " + e.msg);
   }
+  RequireUniqueKeys(root, path);
   if (!root.IsMap()) throw InputError(path, 1, "", "expected a JSON object");
   const YAML::Node command = root["command"];
   const bool calibration =

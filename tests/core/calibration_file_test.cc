@@ -230,6 +230,9 @@ TEST_F(CalibrationFileTest, BadInputNamesFileLineAndKey) {
        6, "imu.temperature.gyro_bias_rad_per_s"},
       {"sigma unknown key", head + "imu:\n  sigma:\n    gyro: {bias: [1, 2, 3]}\n", 5, "imu.sigma.gyro.bias"},
       {"not a mapping", head + "imu: [1, 2]\n", 3, "imu"},
+      {"repeated key", head + "mag:\n  field_uT: 50\n  hard_iron_uT: [1, 2, 3]\n  field_uT: 48\n",
+       6, "mag.field_uT"},
+      {"repeated top key", head + "created_by: again\n", 3, "created_by"},
   };
   for (const BadCase& c : cases) {
     const std::string path = Write("bad.yaml", c.yaml);

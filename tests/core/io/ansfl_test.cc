@@ -136,6 +136,32 @@ TEST(AnsflTest, RawDotUnwrapsTheClockSkipsZeroRowsAndDropsLostRows) {
   EXPECT_NE(notes.find("(1 wraps)"), std::string::npos) << notes;
 }
 
+TEST(AnsflTest, RawDotClockJumpIsAnErrorNotAWrap) {
+  const std::string dir = MakeTempDir();
+  const std::string header =
+      "SampleTimeFine,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z,Mag_X,Mag_Y,"
+      "Mag_Z,\n";
+  const std::string data = "0,0,9.8,0,0,30";
+  const unsigned long long start = 500'000'000ULL;  // 500 s after power-on
+  // One corrupt SampleTimeFine (line 5): near 2^32, then near 0, then back on time.
+  for (const unsigned long long corrupt : {4294967000ULL, 12ULL, start + 8333ULL * 400}) {
+    SCOPED_TRACE(corrupt);
+    std::string text = header;
+    for (int k = 0; k < 8; ++k) text += RawRow(k == 3 ? corrupt : start + 8333ULL * k, data);
+    const std::string path = WriteFile(dir + "/Xsens_DOT8.csv", text);
+    ExpectInputError([&] { ReadAllSamples(*OpenAnsflDotRawImu(path)); },
+                     {path, "line 5", "field 'SampleTimeFine'"});
+    ExpectInputError([&] { DescribeAnsflDotRaw(path); },
+                     {path, "line 5", "field 'SampleTimeFine'"});
+  }
+  // The same at the second row, before any interval is known.
+  const std::string second = WriteFile(
+      dir + "/Xsens_DOT5.csv",
+      header + RawRow(start, data) + RawRow(4294967000ULL, data) + RawRow(start + 8333, data));
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflDotRawImu(second)); },
+                   {"line 3", "field 'SampleTimeFine'"});
+}
+
 TEST(AnsflTest, RawDotNanOutsideThePatternIsAnError) {
   const std::string dir = MakeTempDir();
   const std::string header =

@@ -79,6 +79,79 @@ TEST(RtklibPosTest, UtcNeedsTheLeapSecondsFromTheHeader) {
   EXPECT_NEAR(g[0].t_s, 4 * 86400 + 17 * 3600 + 30 * 60 + 39.749, 1e-9);  // UTC + 18 s
 }
 
+TEST(RtklibPosTest, LeapSecondsHeaderMustBeAPlausibleNonNegativeCount) {
+  const std::string utc_header =
+      "%  UTC   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)\n";
+  const std::string line = "2025/08/28 17:30:21.749 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n";
+  const std::string negative =
+      WriteTempFile("negative.pos", "% leap seconds: -18\n" + utc_header + line);
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(negative)); },
+                   {negative, "line 1", "field 'leap seconds'", "-18"});
+  const std::string huge =
+      WriteTempFile("huge.pos", "% leap seconds: 99999999999999999999\n" + utc_header + line);
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(huge)); },
+                   {huge, "line 1", "field 'leap seconds'"});
+}
+
+TEST(RtklibPosTest, WeekAndTowOutsideGpsLimitsAreRefused) {
+  const std::string head =
+      "%  GPST   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)\n";
+  const std::string rest = " 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n";
+  const struct {
+    const char* name;
+    std::string time;
+    const char* field;
+  } cases[] = {
+      {"overflow", "99999999999999 1.0", "week"},  // week x 604800 beyond int64
+      {"negative_week", "-1 100.0", "week"},
+      {"far_week", "10001 100.0", "week"},
+      {"negative_tow", "2381 -0.5", "tow"},
+      {"full_week_tow", "2381 604800.0", "tow"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path =
+        WriteTempFile(std::string(c.name) + ".pos", head + "2381 100.0" + rest + c.time + rest);
+    ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(path)); },
+                     {path, "line 3", std::string("field '") + c.field + "'"});
+  }
+  // A negative first week is an error too, not "week not set yet".
+  const std::string first = WriteTempFile("first.pos", head + "-5 100.0" + rest);
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(first)); }, {"line 2", "field 'week'"});
+}
+
+TEST(RtklibPosTest, ImpossibleCalendarDatesAndTimesAreRefused) {
+  const std::string head =
+      "%  GPST   latitude(deg) longitude(deg)  height(m)   Q  ns   sdn(m)   sde(m)   sdu(m)\n";
+  const std::string rest = " 40.1 -105.1 1601.4 1 9 0.1 0.1 0.2\n";
+  const struct {
+    const char* name;
+    const char* time;
+    const char* field;
+  } cases[] = {
+      {"feb30", "2024/02/30 00:00:00.000", "date"},
+      {"apr31", "2024/04/31 00:00:00.000", "date"},
+      {"feb29_2023", "2023/02/29 00:00:00.000", "date"},
+      {"month13", "2024/13/01 00:00:00.000", "date"},
+      {"before_gps", "1979/12/31 00:00:00.000", "date"},
+      {"far_year", "99999999999/01/01 00:00:00.000", "date"},
+      {"hour25", "2024/03/01 25:00:00.000", "time"},
+      {"minute60", "2024/03/01 10:60:00.000", "time"},
+      {"second61", "2024/03/01 10:00:61.000", "time"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path =
+        WriteTempFile(std::string(c.name) + ".pos", head + std::string(c.time) + rest);
+    ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(path)); },
+                     {path, "line 2", std::string("field '") + c.field + "'"});
+  }
+  // A leap day that exists is read.
+  const std::string leap_day =
+      WriteTempFile("leap_day.pos", head + "2024/02/29 12:00:00.000" + rest);
+  EXPECT_EQ(ReadAllSamples(*OpenRtklibPos(leap_day)).size(), 1u);
+}
+
 TEST(RtklibPosTest, RefusesOtherSolutionFormats) {
   const std::string xyz = WriteTempFile(
       "xyz.pos",

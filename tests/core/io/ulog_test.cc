@@ -367,6 +367,98 @@ TEST(ULogTest, MalformedDefinitionsAndSizesNameByteOffsetAndField) {
   }
 }
 
+TEST(ULogTest, FormatLargerThanADataMessageIsRefusedAtItsFormatMessage) {
+  // 2 x 40000 bytes: more than the 65535 bytes a data message can hold.
+  ULogWriter w;
+  w.FlagBits(0).Format("inner:uint8_t[40000] v;");
+  const long long at = w.offset();
+  w.Format("outer:uint64_t timestamp;inner[2] a;").Subscribe(0, 0, "outer");
+  const InputError e = CatchInputError([&] { DescribeULog(w.Save("too_big")); });
+  EXPECT_EQ(e.byte_offset(), at);
+  EXPECT_EQ(e.field(), "outer.a");
+  EXPECT_NE(std::string(e.what()).find("65535"), std::string::npos) << e.what();
+}
+
+TEST(ULogTest, NestedArrayFormatBombIsRefusedWithoutExpandingIt) {
+  // 99999 x 99999 x 99999 elements if flattened: refused at the first format that is
+  // too large, before any leaf is built.
+  ULogWriter w;
+  w.FlagBits(0).Format("leaf:uint8_t v;");
+  const long long at = w.offset();
+  w.Format("inner:leaf[99999] e;")
+      .Format("middle:inner[99999] i;")
+      .Format("bomb:uint64_t timestamp;middle[99999] m;")
+      .Subscribe(0, 0, "bomb");
+  const InputError e = CatchInputError([&] { DescribeULog(w.Save("bomb")); });
+  EXPECT_EQ(e.byte_offset(), at);
+  EXPECT_EQ(e.field(), "inner.e");
+}
+
+TEST(ULogTest, CircularOrUndefinedFormatIsAnErrorEvenWithoutSubscription) {
+  {
+    ULogWriter w = ImuLog();
+    w.Format("a:uint64_t timestamp;b x;");
+    const long long at = w.offset();  // "b" closes the loop
+    w.Format("b:a y;").Data(0, ImuData(1'000'000, 0.f, 5000, -9.8f, 5000));
+    const InputError e = CatchInputError([&] { DescribeULog(w.Save("circular")); });
+    EXPECT_EQ(e.byte_offset(), at);
+    EXPECT_EQ(e.field(), "b.y");
+    EXPECT_NE(std::string(e.what()).find("circular"), std::string::npos) << e.what();
+  }
+  {
+    ULogWriter w;
+    w.FlagBits(0);
+    const long long at = w.offset();
+    w.Format("t:uint64_t timestamp;quaternion q;").Format(kSensorCombined);
+    w.Subscribe(0, 0, "sensor_combined").Data(0, ImuData(1'000'000, 0.f, 5000, -9.8f, 5000));
+    const InputError e = CatchInputError([&] { DescribeULog(w.Save("undefined")); });
+    EXPECT_EQ(e.byte_offset(), at);
+    EXPECT_EQ(e.field(), "t.q");
+  }
+  {  // definitions only, no data section at all
+    ULogWriter w;
+    w.FlagBits(0).Format("a:uint64_t timestamp;b x;");
+    const long long at = w.offset();
+    w.Format("b:a y;");
+    EXPECT_EQ(CatchInputError([&] { DescribeULog(w.Save("circular_only")); }).byte_offset(), at);
+  }
+}
+
+TEST(ULogTest, ErrorMessagesAndNotesShowBinaryTextEscapedAndShortened) {
+  auto printable = [](const std::string& text) {
+    return std::all_of(text.begin(), text.end(), [](char c) { return c >= 0x20 && c < 0x7f; });
+  };
+  {  // a subscription whose topic is binary garbage
+    ULogWriter w = ImuLog();
+    w.Subscribe(0, 1, std::string("bad\x01\xff\ntopic"));
+    const InputError e = CatchInputError([&] { DescribeULog(w.Save("binary_topic")); });
+    EXPECT_TRUE(printable(e.what())) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad\\x01\\xff\\x0atopic"), std::string::npos) << e.what();
+  }
+  {  // a malformed format whose name and text are long binary garbage
+    ULogWriter w;
+    w.FlagBits(0).Format(std::string(2000, '\x07') + ":uint64_t timestamp;float[x] v;");
+    const InputError e = CatchInputError([&] { DescribeULog(w.Save("binary_format")); });
+    EXPECT_TRUE(printable(e.what())) << e.what();
+    EXPECT_LT(std::string(e.what()).size(), 600u) << e.what();
+  }
+  {  // a format without a colon: the whole text is echoed
+    ULogWriter w;
+    w.FlagBits(0).Format(std::string("\x1b[2J") + std::string(3000, 'z'));
+    const InputError e = CatchInputError([&] { DescribeULog(w.Save("no_colon")); });
+    EXPECT_TRUE(printable(e.what())) << e.what();
+    EXPECT_LT(std::string(e.what()).size(), 600u) << e.what();
+  }
+  {  // info text shown by DescribeULog
+    ULogWriter w = ImuLog();
+    w.InfoText("sys_name", "PX4\x1b[31m\x01");
+    w.Data(0, ImuData(1'000'000, 0.f, 5000, -9.8f, 5000));
+    const FileSummary summary = DescribeULog(w.Save("binary_info"));
+    EXPECT_TRUE(HasNote(summary, "sys_name: PX4\\x1b[31m\\x01"));
+    for (const std::string& note : summary.notes) EXPECT_TRUE(printable(note)) << note;
+  }
+}
+
 TEST(ULogTest, UnknownIncompatibleFlagIsRefused) {
   ULogWriter w;
   w.FlagBits(0x02).Format(kSensorCombined);

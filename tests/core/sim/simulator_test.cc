@@ -301,5 +301,35 @@ TEST(Simulator, BadScenarioNamesFileLineAndKey) {
   RemoveDir(dir);
 }
 
+TEST(Simulator, DuplicateScenarioKeyNamesFileLineAndKey) {
+  const std::string dir = MakeTempDir();
+  const std::string nested = dir + "/nested.yaml";
+  std::ofstream(nested) << "name: dup\nstart: {lat_deg: 10, lon_deg: 20}\ntrajectory:\n"
+                           "  segments:\n    - {kind: cruise, duration_s: 10}\nimu:\n"
+                           "  rate_hz: 100\n  errors:\n    gyro: {bias_deg_h: 1}\n"
+                           "  rate_hz: 200\n";
+  const std::string top = dir + "/top.yaml";
+  std::ofstream(top) << "name: dup\nstart: {lat_deg: 10, lon_deg: 20}\nname: again\n";
+  const std::string flow = dir + "/flow.yaml";
+  std::ofstream(flow) << "name: dup\nstart: {lat_deg: 10, lon_deg: 20, lat_deg: 11}\n";
+  const struct {
+    std::string path;
+    long line;
+    const char* key;
+  } cases[] = {{nested, 10, "imu.rate_hz"}, {top, 3, "name"}, {flow, 2, "start.lat_deg"}};
+  for (const auto& c : cases) {
+    try {
+      LoadScenario(c.path);
+      ADD_FAILURE() << "no error for a repeated key in " << c.path;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), c.path);
+      EXPECT_EQ(e.line(), c.line) << e.what();
+      EXPECT_EQ(e.field(), c.key) << e.what();
+      EXPECT_NE(std::string(e.what()).find("repeated"), std::string::npos) << e.what();
+    }
+  }
+  RemoveDir(dir);
+}
+
 }  // namespace sim_simulator_test
 }  // namespace navtwin::sim

@@ -459,6 +459,15 @@ TEST(KfginsConfig, BadValues) {
   ExpectInputError([&] { LoadKfginsConfig(n); }, {n, "line 20", "imunoise.arw"});
 }
 
+TEST(KfginsConfig, RepeatedKeyNamesFileLineAndKey) {
+  const std::string top = WriteTempFile("top.yaml", std::string(kKfgins) + "starttime: 1\n");
+  ExpectInputError([&] { LoadKfginsConfig(top); }, {top, "line 28", "field 'starttime'", "repeated"});
+  const std::string nested = WriteTempFile(
+      "nested.yaml", Replace(kKfgins, "  corrtime: 4.0", "  corrtime: 4.0\n  arw: [1, 1, 1]"));
+  ExpectInputError([&] { LoadKfginsConfig(nested); },
+                   {nested, "line 27", "field 'imunoise.arw'", "repeated"});
+}
+
 TEST(KfginsConfig, ZeroScaleStdTurnsScaleFactorsOff) {
   std::string text = kKfgins;
   text = Replace(text, "gsstd: [300.0, 300.0, 300.0]", "gsstd: [0.0, 0.0, 0.0]");
