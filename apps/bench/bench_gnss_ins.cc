@@ -109,7 +109,7 @@ void BM_Filter(benchmark::State& state) {
     const FilterResult result = RunFilter(inputs, config, /*run_rts=*/false,
                                           [&](const NavEpoch& e) {
                                             if (!decimator.Take(e.state.nav.t_s)) return;
-                                            writer.Write(e);
+                                            writer.Write(e, /*with_std=*/true);
                                             ++outputs;
                                           },
                                           nullptr);

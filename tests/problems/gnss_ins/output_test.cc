@@ -75,8 +75,8 @@ TEST(NavOutputWriter, WritesFourFilesInTheirUnits) {
   const std::string dir = MakeTempDir();
   {
     NavOutputWriter w(dir, /*scale_factors=*/false);
-    w.Write(Epoch(100.0, 15));
-    w.Write(Epoch(100.005, 15));
+    w.Write(Epoch(100.0, 15), true);
+    w.Write(Epoch(100.005, 15), true);
     EXPECT_EQ(w.count(), 2u);
     for (const char* f : NavOutputWriter::kFiles) EXPECT_FALSE(Exists(dir + "/" + f)) << f;
     w.Commit();
@@ -125,8 +125,8 @@ TEST(NavOutputWriter, WritesFourFilesInTheirUnits) {
 TEST(NavOutputWriter, ScaleFactorColumnsAndMissingStd) {
   const std::string dir = MakeTempDir();
   NavOutputWriter w(dir, /*scale_factors=*/true);
-  w.Write(Epoch(1.0, 21));
-  w.Write(Epoch(2.0, 0));  // no standard deviations computed: nan
+  w.Write(Epoch(1.0, 21), true);
+  w.Write(Epoch(2.0, 0), true);  // no standard deviations computed: nan
   w.Commit();
   const auto sd = Lines(dir + "/std.csv");
   ASSERT_EQ(sd.size(), 3u);
@@ -148,7 +148,7 @@ TEST(NavOutputWriter, NothingAppearsWithoutCommit) {
   const std::string dir = MakeTempDir();
   {
     NavOutputWriter w(dir, false);
-    w.Write(Epoch(1.0, 15));
+    w.Write(Epoch(1.0, 15), true);
   }
   EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
 }
@@ -158,7 +158,7 @@ TEST(NavOutputWriter, RejectsNonFiniteStates) {
   NavOutputWriter w(dir, false);
   NavEpoch e = Epoch(1.0, 15);
   e.state.nav.h_m = std::nan("");
-  EXPECT_THROW(w.Write(e), std::invalid_argument);
+  EXPECT_THROW(w.Write(e, true), std::invalid_argument);
 }
 
 // A method's folder: nav.csv and std.csv the same lines as the top-level files, residuals.csv
@@ -168,8 +168,8 @@ TEST(MethodOutputWriter, WritesTheMethodsFilesAndRevokesThem) {
   NavOutputWriter top(dir, false);
   MethodOutputWriter method(dir, "batch", false);
   for (double t : {1.0, 2.0}) {
-    top.Write(Epoch(t, 15));
-    method.Write(Epoch(t, 15));
+    top.Write(Epoch(t, 15), true);
+    method.Write(Epoch(t, 15), true);
   }
   const double nan = std::nan("");
   method.WriteResiduals({{1.5, "gnss_position", 3, 2.25, false}, {2.0, "baro", 0, nan, true}});
@@ -187,12 +187,39 @@ TEST(MethodOutputWriter, WritesTheMethodsFilesAndRevokesThem) {
   EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
 }
 
+// The output method's folder shares the top-level nav.csv and std.csv (hard links, the same
+// file); std.csv and imu_errors.csv only hold the epochs marked with_std; Revoke removes
+// the links with the folder.
+TEST(MethodOutputWriter, OutputMethodSharesTheTopLevelFiles) {
+  const std::string dir = MakeTempDir();
+  NavOutputWriter top(dir, false);
+  MethodOutputWriter method(dir, "filter", false);
+  method.ShareTopLevelFiles();
+  for (double t : {1.0, 1.5, 2.0}) top.Write(Epoch(t, 15), /*with_std=*/t != 1.5);
+  EXPECT_THROW(method.Write(Epoch(3.0, 15), true), std::logic_error);
+  top.Commit();
+  method.Commit();
+  EXPECT_EQ(Lines(dir + "/nav.csv").size(), 4u);
+  EXPECT_EQ(Lines(dir + "/std.csv").size(), 3u);  // header, t = 1 and 2
+  EXPECT_EQ(Lines(dir + "/imu_errors.csv").size(), 3u);
+  EXPECT_EQ(Lines(dir + "/nav.nav").size(), 3u);
+  for (const char* name : {"nav.csv", "std.csv"}) {
+    struct stat a, b;
+    ASSERT_EQ(::stat((dir + "/" + name).c_str(), &a), 0);
+    ASSERT_EQ(::stat((dir + "/filter/" + name).c_str(), &b), 0);
+    EXPECT_EQ(a.st_ino, b.st_ino) << name << ": one file, two names";
+  }
+  method.Revoke();
+  top.Revoke();
+  EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
+}
+
 // A writer destroyed before Commit (a failed run) removes its files and the folder it made.
 TEST(MethodOutputWriter, NothingAppearsWithoutCommit) {
   const std::string dir = MakeTempDir();
   {
     MethodOutputWriter w(dir, "filter", true);
-    w.Write(Epoch(1.0, 21));
+    w.Write(Epoch(1.0, 21), true);
     w.OpenErrors(true);
     w.WriteResiduals({});
   }
