@@ -6,6 +6,7 @@
 //   Batch/minutes:N       the full-batch Ceres smoother (started from the filter, with the
 //                         per-state covariance) over the first N = 15, 30, 60 minutes;
 //                         the filter run that starts it is not timed
+//   ParseImu, FilterOnly, WriteEveryEpoch   the stages of `navtwin navigate` apart (below)
 // Each case reports peak_rss_MB, the process's peak resident memory after the case: run one
 // case per process for per-case figures, e.g.
 //   <build>/bin/bench_gnss_ins --benchmark_filter='Batch/minutes:30'
@@ -20,6 +21,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/io/open.h"
 #include "core/sim/simulator.h"
@@ -121,6 +123,66 @@ void BM_Filter(benchmark::State& state) {
   state.counters["peak_rss_MB"] = PeakRss_MB();
 }
 BENCHMARK(BM_Filter)->ArgName("output_hz")->Arg(10)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1);
+
+// The three stages of `navtwin navigate` apart (issue: the filter at disk speed):
+//   ParseImu             the KF-GINS IMU text through the reader (OpenImu), MB/s and samples/s
+//   FilterOnly           the filter over the loaded hour, its states dropped (no output)
+//   WriteEveryEpoch      nav.nav and nav.csv at every IMU epoch, std.csv and imu_errors.csv
+//                        at 1 Hz (the defaults), from states kept in memory
+void BM_ParseImu(benchmark::State& state) {
+  const NavGradeHour& hour = NavGradeHour::Get();
+  const std::string path = Paths(hour).imu;
+  std::size_t samples = 0;
+  for (auto _ : state) {
+    const std::unique_ptr<ImuReader> reader = OpenImu(path);
+    ImuSample s;
+    samples = 0;
+    while (reader->Next(&s)) ++samples;
+    benchmark::DoNotOptimize(s);
+  }
+  const double bytes = static_cast<double>(std::filesystem::file_size(path));
+  state.counters["MB_per_s"] = benchmark::Counter(bytes / 1e6, benchmark::Counter::kIsRate);
+  state.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+  state.counters["peak_rss_MB"] = PeakRss_MB();
+}
+BENCHMARK(BM_ParseImu)->Unit(benchmark::kSecond)->Iterations(1);
+
+void BM_FilterOnly(benchmark::State& state) {
+  const NavGradeHour& hour = NavGradeHour::Get();
+  const GnssInsConfig config = hour.Config(60.0);
+  const Inputs inputs = LoadInputs(Paths(hour), config);
+  for (auto _ : state) {
+    const FilterResult result = RunFilter(inputs, config, /*run_rts=*/false, [](const NavEpoch&) {}, nullptr);
+    benchmark::DoNotOptimize(result.filter.epochs.size());
+  }
+  state.counters["samples_per_s"] =
+      benchmark::Counter(static_cast<double>(inputs.imu.size()), benchmark::Counter::kIsRate);
+  state.counters["peak_rss_MB"] = PeakRss_MB();
+}
+BENCHMARK(BM_FilterOnly)->Unit(benchmark::kSecond)->Iterations(1);
+
+void BM_WriteEveryEpoch(benchmark::State& state) {
+  const NavGradeHour& hour = NavGradeHour::Get();
+  const GnssInsConfig config = hour.Config(60.0);
+  const Inputs inputs = LoadInputs(Paths(hour), config);
+  std::vector<NavEpoch> epochs;
+  epochs.reserve(inputs.imu.size());
+  RunFilter(inputs, config, /*run_rts=*/false, [&epochs](const NavEpoch& e) { epochs.push_back(e); }, nullptr);
+  const std::string out_dir = hour.dir() + "/write_out";
+  std::filesystem::create_directories(out_dir);
+  double bytes = 0.0;
+  for (auto _ : state) {
+    NavOutputWriter writer(out_dir, config.filter.scale_factors);
+    OutputDecimator std_epochs(config.std_rate_hz);
+    for (const NavEpoch& e : epochs) writer.Write(e, std_epochs.Take(e.state.nav.t_s));
+    writer.Commit();
+  }
+  for (const char* f : NavOutputWriter::kFiles) bytes += static_cast<double>(std::filesystem::file_size(out_dir + "/" + f));
+  state.counters["MB_per_s"] = benchmark::Counter(bytes / 1e6, benchmark::Counter::kIsRate);
+  state.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(epochs.size()), benchmark::Counter::kIsRate);
+  state.counters["peak_rss_MB"] = PeakRss_MB();
+}
+BENCHMARK(BM_WriteEveryEpoch)->Unit(benchmark::kSecond)->Iterations(1);
 
 void BM_Batch(benchmark::State& state) {
   const NavGradeHour& hour = NavGradeHour::Get();

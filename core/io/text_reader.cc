@@ -1,5 +1,6 @@
 #include "core/io/text_reader.h"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -117,14 +118,22 @@ void SplitCsv(std::string_view line, std::vector<std::string_view>* fields) {
 }
 
 void SplitLoose(std::string_view line, std::vector<std::string_view>* fields) {
+  // A table of the separators (blanks and ','): one load per character instead of six
+  // comparisons; this loop was 40 % of reading a KF-GINS IMU file.
+  static const auto kSeparator = [] {
+    std::array<bool, 256> table{};
+    for (int c = 0; c < 256; ++c) table[c] = IsBlankChar(static_cast<char>(c)) || c == ',';
+    return table;
+  }();
+  const auto separator = [](char c) { return kSeparator[static_cast<unsigned char>(c)]; };
   fields->clear();
-  std::size_t i = 0;
-  const std::size_t n = line.size();
-  while (i < n) {
-    while (i < n && (IsBlankChar(line[i]) || line[i] == ',')) ++i;
-    const std::size_t start = i;
-    while (i < n && !IsBlankChar(line[i]) && line[i] != ',') ++i;
-    if (i > start) fields->push_back(line.substr(start, i - start));
+  const char* p = line.data();
+  const char* const end = p + line.size();
+  while (p < end) {
+    while (p < end && separator(*p)) ++p;
+    const char* start = p;
+    while (p < end && !separator(*p)) ++p;
+    if (p > start) fields->emplace_back(start, static_cast<std::size_t>(p - start));
   }
 }
 
