@@ -34,7 +34,39 @@ int Usage(const std::string& why) {
 std::string CommandLine() {
   std::ostringstream s;
   s << "navtwin calibrate-imu --rig " << FLAGS_rig << " --data " << FLAGS_data;
+  if (FLAGS_method == "recursive") s << " --method recursive";
   return s.str();
+}
+
+/// The rig's calibration; the recursive multi-position form prints each position's
+/// estimate (text format) and keeps them in *steps.
+calibration::ImuCalibrationResult Calibrate(bool recursive, std::vector<calibration::ImuCalibrationResult>* steps) {
+  if (recursive) {
+    return calibration::CalibrateMultiPositionRecordRecursive(
+        FLAGS_data, [steps](const calibration::ImuCalibrationResult& estimate) {
+          if (FLAGS_format == "text") std::cout << calibration::RecursiveStepText(estimate, steps->empty());
+          steps->push_back(estimate);
+        });
+  }
+  if (FLAGS_rig == "multiposition") return calibration::CalibrateMultiPositionRecord(FLAGS_data);
+  if (FLAGS_rig == "pendulum") return calibration::CalibratePendulumRecord(FLAGS_data);
+  return calibration::CalibrateTemperatureRecord(FLAGS_data);
+}
+
+/// --run_dir: the folder (docs/run-folder.md) and with --report its page.
+void WriteRunFolder(const calibration::ImuCalibrationResult& result, const CalibrationFile& file,
+                    const std::vector<calibration::ImuCalibrationResult>& steps) {
+  std::vector<calibration::RunFolderFile> files = {
+      {"parameters.csv", [&result](std::ostream& o) { calibration::WriteImuParametersCsv(o, result); }},
+      {"residuals.csv", [&result](std::ostream& o) { calibration::WriteImuResidualsCsv(o, result); }}};
+  if (!steps.empty()) {
+    files.push_back({"convergence.csv", [&steps](std::ostream& o) { calibration::WriteImuConvergenceCsv(o, steps); }});
+  }
+  calibration::WriteCalibrationRunFolder(FLAGS_run_dir, calibration::ImuCalibrationJson(result, FLAGS_rig, "calibrate-imu"),
+                                         file, files);
+  std::cerr << "calibrate-imu: run folder " << FLAGS_run_dir << " (summary.json, calibration.yaml, parameters.csv, "
+            << "residuals.csv" << (steps.empty() ? "" : ", convergence.csv") << ")\n";
+  if (FLAGS_report) WriteRunReport("calibrate-imu", FLAGS_run_dir);
 }
 
 int RunCalibrateImu(const std::vector<std::string>& args) {
@@ -42,30 +74,21 @@ int RunCalibrateImu(const std::vector<std::string>& args) {
   if (FLAGS_data.empty()) return Usage("--data RECORD is required");
   if (FLAGS_format != "text" && FLAGS_format != "json") return Usage("--format must be text or json");
   if (FLAGS_report && FLAGS_run_dir.empty()) return Usage("--report needs --run_dir DIR (it writes DIR/report.html)");
-  calibration::ImuCalibrationResult result;
-  if (FLAGS_rig == "multiposition") {
-    result = calibration::CalibrateMultiPositionRecord(FLAGS_data);
-  } else if (FLAGS_rig == "pendulum") {
-    result = calibration::CalibratePendulumRecord(FLAGS_data);
-  } else if (FLAGS_rig == "temperature") {
-    result = calibration::CalibrateTemperatureRecord(FLAGS_data);
-  } else if (FLAGS_rig.empty()) {
-    return Usage("--rig is required: multiposition, pendulum or temperature");
-  } else {
+  if (FLAGS_rig.empty()) return Usage("--rig is required: multiposition, pendulum or temperature");
+  if (FLAGS_rig != "multiposition" && FLAGS_rig != "pendulum" && FLAGS_rig != "temperature") {
     return Usage("unknown --rig '" + FLAGS_rig + "': multiposition, pendulum or temperature");
   }
+  const std::string method = FLAGS_method.empty() ? "batch" : FLAGS_method;
+  if (method != "batch" && method != "recursive") return Usage("--method must be batch or recursive");
+  if (method == "recursive" && FLAGS_rig != "multiposition") {
+    return Usage("--method recursive is the multi-position rig's recursive form (--rig multiposition)");
+  }
+  std::vector<calibration::ImuCalibrationResult> steps;
+  const calibration::ImuCalibrationResult result = Calibrate(method == "recursive", &steps);
   CalibrationFile file;
   file.created_by = CommandLine();
   file.imu = result.calibration;
-  if (!FLAGS_run_dir.empty()) {
-    calibration::WriteCalibrationRunFolder(
-        FLAGS_run_dir, calibration::ImuCalibrationJson(result, FLAGS_rig, "calibrate-imu"), file,
-        {{"parameters.csv", [&result](std::ostream& o) { calibration::WriteImuParametersCsv(o, result); }},
-         {"residuals.csv", [&result](std::ostream& o) { calibration::WriteImuResidualsCsv(o, result); }}});
-    std::cerr << "calibrate-imu: run folder " << FLAGS_run_dir
-              << " (summary.json, calibration.yaml, parameters.csv, residuals.csv)\n";
-    if (FLAGS_report) WriteRunReport("calibrate-imu", FLAGS_run_dir);
-  }
+  if (!FLAGS_run_dir.empty()) WriteRunFolder(result, file, steps);
   if (!FLAGS_out.empty()) WriteCalibrationFile(FLAGS_out, file);
   if (FLAGS_format == "json") {
     std::cout << calibration::ImuCalibrationJson(result, FLAGS_rig) << "\n";
@@ -81,8 +104,8 @@ int RunCalibrateImu(const std::vector<std::string>& args) {
 Command CalibrateImuCommand() {
   return {"calibrate-imu",
           "IMU scale factor, misalignment, bias and g-sensitivity (with sigma) from a calibration record",
-          "navtwin calibrate-imu --data RECORD --rig multiposition|pendulum|temperature [--out FILE] "
-          "[--run_dir DIR [--report]] [--format=json]\n"
+          "navtwin calibrate-imu --data RECORD --rig multiposition|pendulum|temperature [--method batch|recursive] "
+          "[--out FILE] [--run_dir DIR [--report]] [--format=json]\n"
           "  RECORD is a YAML file naming the IMU files and what the rig did (docs/calibration-imu.md):\n"
           "  - multiposition: {imu, latitude_deg, height_m, trajectory: {kind: multiposition, ...}}, the\n"
           "    table schedule in the simulator's schema, on the IMU's time scale;\n"
@@ -95,9 +118,12 @@ Command CalibrateImuCommand() {
           "  at 0); --out writes the calibration file that --calibration applies to IMU readers; --run_dir\n"
           "  the run folder (docs/run-folder.md: summary, calibration file, parameters, residuals before\n"
           "  and after) and with --report its page (navtwin report DIR).\n"
+          "  --method recursive (multiposition): the recursive form, position by position; prints the\n"
+          "  estimate after each position (biases and scale factors with sigma) and the final one as\n"
+          "  the batch does; --run_dir adds convergence.csv, which the report draws.\n"
           "  Exit 1 for records that cannot calibrate (too few positions, a temperature span too\n"
           "  small for the order, ...), with what is missing; nothing is written then.",
-          {"data", "rig", "out", "run_dir", "report"},
+          {"data", "rig", "method", "out", "run_dir", "report"},
           &RunCalibrateImu};
 }
 

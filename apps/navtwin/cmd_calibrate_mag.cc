@@ -148,10 +148,31 @@ void WriteJson(std::ostream& out, const MagCalibration& c, const HeadingErrors& 
       .EndObject();
 }
 
-/// The fit of --method; the bidirectional one over the samples with a roll and pitch.
+/// A recursive estimate as the terminal shows it.
+void PrintRecursiveStep(const calibration::RecursiveMagStep& s, bool header) {
+  if (header) std::printf("recursive ellipsoid fit: the estimate after every 1/20 of the samples\n");
+  if (!s.estimate) {
+    std::printf("  %7zu samples (t = %.2f s): not yet (%s)\n", s.samples, s.t_s, s.why_not.c_str());
+    return;
+  }
+  const MagCalibration& c = *s.estimate;
+  std::printf("  %7zu samples (t = %.2f s): hard iron %9.4f %9.4f %9.4f uT, field %8.4f uT\n", s.samples, s.t_s,
+              c.hard_iron_uT.x(), c.hard_iron_uT.y(), c.hard_iron_uT.z(), c.field_uT);
+}
+
+/// The fit of --method; the bidirectional one over the samples with a roll and pitch; the
+/// recursive one prints its estimates (text format) and keeps them in *steps.
 MagCalibration FitByMethod(const std::vector<MagSample>& mag,
-                           const std::vector<std::optional<Eigen::Vector2d>>& roll_pitch) {
+                           const std::vector<std::optional<Eigen::Vector2d>>& roll_pitch,
+                           std::vector<calibration::RecursiveMagStep>* steps) {
   if (FLAGS_method == "planar") return calibration::FitPlanar(mag);
+  if (FLAGS_method == "recursive") {
+    const std::size_t block = std::max<std::size_t>(1, mag.size() / 20);
+    return calibration::FitRecursive(mag, FLAGS_field_uT, block, [steps](const calibration::RecursiveMagStep& s) {
+      if (FLAGS_format == "text") PrintRecursiveStep(s, steps->empty());
+      steps->push_back(s);
+    });
+  }
   if (FLAGS_method == "ellipsoid") {
     calibration::EllipsoidFitOptions options;
     options.field_uT = FLAGS_field_uT;
@@ -174,14 +195,17 @@ MagCalibration FitByMethod(const std::vector<MagSample>& mag,
 int RunCalibrateMag(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args.front() + "'");
   if (FLAGS_mag.empty()) return Usage("--mag FILE is required");
-  if (FLAGS_method != "ellipsoid" && FLAGS_method != "planar" && FLAGS_method != "bidirectional") {
-    return Usage("--method must be ellipsoid, planar or bidirectional, got '" + FLAGS_method + "'");
+  if (FLAGS_method != "ellipsoid" && FLAGS_method != "planar" && FLAGS_method != "bidirectional" &&
+      FLAGS_method != "recursive") {
+    return Usage("--method must be ellipsoid, planar, bidirectional or recursive, got '" + FLAGS_method + "'");
   }
   if (!std::isfinite(FLAGS_declination_deg)) return Usage("--declination_deg must be a finite angle, deg");
   if (!(std::isfinite(FLAGS_field_uT) && FLAGS_field_uT >= 0.0)) return Usage("--field_uT must be >= 0 (0: from the data)");
   const bool two_axis = FLAGS_method == "bidirectional";
   if (FLAGS_report && FLAGS_run_dir.empty()) return Usage("--report needs --run_dir DIR (it writes DIR/report.html)");
-  if (FLAGS_method != "ellipsoid" && FLAGS_field_uT != 0.0) return Usage("--field_uT goes with --method ellipsoid");
+  if (FLAGS_method != "ellipsoid" && FLAGS_method != "recursive" && FLAGS_field_uT != 0.0) {
+    return Usage("--field_uT goes with --method ellipsoid or recursive");
+  }
 
   std::vector<MagSample> mag = ReadAll<MagSample>(*OpenMag(FLAGS_mag));
   if (mag.empty()) throw InputError(FLAGS_mag, 0, "t_s", "no magnetometer samples");
@@ -200,8 +224,9 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
   const std::string& attitude = attitudes.source;
 
   MagCalibration c;
+  std::vector<calibration::RecursiveMagStep> steps;
   try {
-    c = FitByMethod(mag, attitudes.roll_pitch_rad);
+    c = FitByMethod(mag, attitudes.roll_pitch_rad, &steps);
   } catch (const std::runtime_error& e) {  // data that cannot calibrate: the reason, with what was read
     std::cerr << "navtwin calibrate-mag: refused (" << mag.size() << " samples, |m| spread "
               << Fixed(calibration::FieldMagnitudeSpread_uT(mag), 4) << " uT): " << e.what() << "\n";
@@ -220,10 +245,14 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
   if (!FLAGS_run_dir.empty()) {
     std::ostringstream summary;
     WriteJson(summary, c, heading, attitude, "calibrate-mag");
-    calibration::WriteCalibrationRunFolder(
-        FLAGS_run_dir, summary.str(), file,
-        {{"residuals.csv", [&c, &mag](std::ostream& o) { calibration::WriteMagResidualsCsv(o, c, mag); }}});
-    std::cerr << "calibrate-mag: run folder " << FLAGS_run_dir << " (summary.json, calibration.yaml, residuals.csv)\n";
+    std::vector<calibration::RunFolderFile> files = {
+        {"residuals.csv", [&c, &mag](std::ostream& o) { calibration::WriteMagResidualsCsv(o, c, mag); }}};
+    if (!steps.empty()) {
+      files.push_back({"convergence.csv", [&steps](std::ostream& o) { calibration::WriteMagConvergenceCsv(o, steps); }});
+    }
+    calibration::WriteCalibrationRunFolder(FLAGS_run_dir, summary.str(), file, files);
+    std::cerr << "calibrate-mag: run folder " << FLAGS_run_dir << " (summary.json, calibration.yaml, residuals.csv"
+              << (steps.empty() ? "" : ", convergence.csv") << ")\n";
     if (FLAGS_report) WriteRunReport("calibrate-mag", FLAGS_run_dir);
   }
   if (!FLAGS_out.empty()) WriteCalibrationFile(FLAGS_out, file);
@@ -241,9 +270,11 @@ int RunCalibrateMag(const std::vector<std::string>& args) {
 
 Command CalibrateMagCommand() {
   return {"calibrate-mag",
-          "Magnetometer hard and soft iron: 3-axis ellipsoid fit, planar fit or the 2-axis bidirectional method",
-          "navtwin calibrate-mag --mag F --method ellipsoid|planar|bidirectional [--imu F] [--truth NAV] "
+          "Magnetometer hard and soft iron: 3-axis ellipsoid fit (batch or recursive), planar fit or the 2-axis bidirectional method",
+          "navtwin calibrate-mag --mag F --method ellipsoid|recursive|planar|bidirectional [--imu F] [--truth NAV] "
           "[--declination_deg D] [--field_uT B] [--out FILE] [--run_dir DIR [--report]] [--format=json]\n"
+          "  recursive: the ellipsoid fit's recursive form, sample by sample, printing the estimate after\n"
+          "  every 1/20 of the record (--run_dir adds convergence.csv); no sigma.\n"
           "  planar: 3-axis data near one plane (a level turn in any sensor plane); the axis normal to\n"
           "  the plane is not calibrated (reported as uncalibrated_axis_sensor).\n"
           "  Roll and pitch come from --truth, else the --imu accelerometer, else level; the heading error\n"

@@ -222,6 +222,72 @@ void WriteImuResidualsCsv(std::ostream& out, const ImuCalibrationResult& result)
   }
 }
 
+namespace {
+
+/// A column-name unit: '/' as '_' ("deg/h/g" -> "deg_h_g").
+std::string UnitSuffix(const char* unit) {
+  std::string s = unit;
+  for (char& c : s) c = c == '/' ? '_' : c;
+  return s;
+}
+
+}  // namespace
+
+std::string RecursiveStepText(const ImuCalibrationResult& estimate, bool header) {
+  std::ostringstream out;
+  const std::vector<std::string> shown = {"accel.bias.", "gyro.bias.", "accel.scale_factor.", "gyro.scale_factor."};
+  if (header) {
+    out << "recursive multi-position calibration: the estimate after each position (value +- 1 sigma; - not yet "
+           "observable, held at 0, and the sigma of the others conditional on that)\n";
+    char head[256];
+    std::snprintf(head, sizeof head, "%3s %9s  %-54s %-54s %-54s %s\n", "pos", "t_s", "accel bias x, y, z [mg]",
+                  "gyro bias x, y, z [deg/h]", "accel scale factor x, y, z [ppm]", "gyro scale factor x, y, z [ppm]");
+    out << head;
+  }
+  const double t_s = estimate.static_positions.empty() ? NAN : estimate.static_positions.back().t1_s;
+  char line[96];
+  std::snprintf(line, sizeof line, "%3d %9.1f ", estimate.positions, t_s);
+  out << line;
+  const std::vector<Row> rows = AllRows(estimate);
+  for (const std::string& prefix : shown) {
+    std::string cell;
+    for (const Row& r : rows) {
+      if (r.name.rfind(prefix, 0) != 0 || r.name.size() != prefix.size() + 1) continue;
+      if (std::isfinite(r.sigma)) {
+        std::snprintf(line, sizeof line, " %8.4g+-%-6.2g", r.value * r.per_si, r.sigma * r.per_si);
+      } else {
+        std::snprintf(line, sizeof line, " %8s   %-6s", "-", "");
+      }
+      cell += line;
+    }
+    out << " " << cell;
+  }
+  out << "\n";
+  return out.str();
+}
+
+void WriteImuConvergenceCsv(std::ostream& out, const std::vector<ImuCalibrationResult>& estimates) {
+  if (estimates.empty()) return;
+  const std::vector<Row> names = AllRows(estimates.back());
+  out << "positions,t_s";
+  for (const Row& r : names) out << "," << r.name << "_" << UnitSuffix(r.unit) << "," << r.name << "_sigma_" << UnitSuffix(r.unit);
+  out << "\n";
+  for (const ImuCalibrationResult& e : estimates) {
+    out << e.positions << "," << (e.static_positions.empty() ? NAN : e.static_positions.back().t1_s);
+    const std::vector<Row> rows = AllRows(e);
+    for (const Row& name : names) {
+      double value = NAN, sigma = NAN;
+      for (const Row& r : rows) {
+        if (r.name != name.name) continue;
+        value = std::isfinite(r.sigma) ? r.value * r.per_si : NAN;
+        sigma = r.sigma * r.per_si;
+      }
+      out << "," << value << "," << sigma;
+    }
+    out << "\n";
+  }
+}
+
 std::string ImuCalibrationText(const ImuCalibrationResult& result, const std::string& rig) {
   std::ostringstream out;
   out << "IMU calibration (" << rig << "), " << result.positions

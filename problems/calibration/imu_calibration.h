@@ -18,6 +18,7 @@
 //                  (docs/calibration-temperature.md).
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <ostream>
 #include <string>
@@ -95,11 +96,24 @@ void WriteImuParametersCsv(std::ostream& out, const ImuCalibrationResult& result
 /// gyro_after_{x,y,z}_deg_h` (rms 1: a pendulum run's RMS, 0: a static position's mean residual).
 void WriteImuResidualsCsv(std::ostream& out, const ImuCalibrationResult& result);
 
+/// The recursive estimates, one per static position, as the terminal shows them: a header
+/// (with `header`), then per estimate its positions, the end of its last position and the
+/// accelerometer and gyro biases and scale factors with 1σ ("-" while not observable).
+std::string RecursiveStepText(const ImuCalibrationResult& estimate, bool header);
+/// convergence.csv of the run folder: one row per recursive estimate, `positions,t_s`, then
+/// per parameter (the rows of parameters.csv) `<name>_<unit>` and `<name>_sigma_<unit>`
+/// (unit with '/' as '_': mg, deg_h, ppm, mrad, deg_h_g), nan while not estimated.
+void WriteImuConvergenceCsv(std::ostream& out, const std::vector<ImuCalibrationResult>& estimates);
+
 /// Reads a record file and calibrates. Throw InputError (file, line, key) for bad records
 /// and std::runtime_error naming what is missing for data that cannot calibrate (too few
 /// positions, a temperature span too small for the order, ...). Defined in
 /// multiposition.cc, pendulum.cc and temperature.cc.
 ImuCalibrationResult CalibrateMultiPositionRecord(const std::string& record_path);
+/// The recursive form of the multi-position record (RecursiveMultiPosition): the estimate
+/// after every static position goes to `on_position`; returns the last one.
+ImuCalibrationResult CalibrateMultiPositionRecordRecursive(
+    const std::string& record_path, const std::function<void(const ImuCalibrationResult&)>& on_position);
 ImuCalibrationResult CalibratePendulumRecord(const std::string& record_path);
 ImuCalibrationResult CalibrateTemperatureRecord(const std::string& record_path);
 

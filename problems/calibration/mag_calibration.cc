@@ -473,6 +473,47 @@ MagCalibration RecursiveEllipsoidFit::Current() const {
   return c;
 }
 
+MagCalibration FitRecursive(const std::vector<MagSample>& samples, double field_uT, std::size_t block,
+                            const std::function<void(const RecursiveMagStep&)>& on_step) {
+  if (samples.empty()) throw std::runtime_error("FitRecursive: no samples");
+  RecursiveEllipsoidFit fit(field_uT);
+  RecursiveMagStep step;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    fit.Add(samples[i].m_b_uT);
+    if ((i + 1) % std::max<std::size_t>(block, 1) != 0 && i + 1 != samples.size()) continue;
+    step = RecursiveMagStep{i + 1, samples[i].t_s, std::nullopt, ""};
+    try {
+      step.estimate = fit.Current();
+    } catch (const std::runtime_error& e) {
+      step.why_not = e.what();
+    }
+    if (on_step) on_step(step);
+  }
+  if (!step.estimate) throw std::runtime_error(step.why_not);
+  MagCalibration c = *step.estimate;
+  std::vector<double> before, after;
+  double ss = 0.0;
+  for (const MagSample& s : samples) {
+    const FieldMagnitude f = FieldMagnitudeOf(c, s.m_b_uT);
+    before.push_back(f.before_uT);
+    after.push_back(f.after_uT);
+    ss += (f.after_uT - c.field_uT) * (f.after_uT - c.field_uT);
+  }
+  c.residual_rms_uT = std::sqrt(ss / static_cast<double>(samples.size()));
+  c.field_spread_before_uT = MeanStd(before).second;
+  c.field_spread_after_uT = MeanStd(after).second;
+  return c;
+}
+
+void WriteMagConvergenceCsv(std::ostream& out, const std::vector<RecursiveMagStep>& steps) {
+  out << "samples,t_s,hard_iron_x_uT,hard_iron_y_uT,hard_iron_z_uT,field_uT\n";
+  for (const RecursiveMagStep& s : steps) {
+    out << s.samples << "," << s.t_s;
+    for (int i = 0; i < 3; ++i) out << "," << (s.estimate ? s.estimate->hard_iron_uT[i] : NAN);
+    out << "," << (s.estimate ? s.estimate->field_uT : NAN) << "\n";
+  }
+}
+
 // ------------------------------------------------------------------------ planar (3-axis, one plane)
 
 // Data near one plane (a level turn of a 3-axis sensor, in whatever sensor plane):

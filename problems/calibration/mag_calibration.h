@@ -34,6 +34,8 @@
 //    LevelHeading (2-axis), both plus the declination to true north.
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -119,6 +121,26 @@ class RecursiveEllipsoidFit {
   Eigen::Matrix<double, 9, 9> P_;
   Eigen::Matrix<double, 9, 1> theta_;
 };
+
+/// One estimate of the recursive fit over a record (FitRecursive): after `samples` samples
+/// (the last at t_s), the calibration, or why there is none yet.
+struct RecursiveMagStep {
+  std::size_t samples = 0;
+  double t_s = 0.0;
+  std::optional<MagCalibration> estimate;
+  std::string why_not;  ///< when !estimate
+};
+
+/// RecursiveEllipsoidFit over `samples` in order, with an estimate after every `block`
+/// samples and after the last (to `on_step`); returns the last estimate with its residual
+/// RMS and |m| spreads over every sample (as FitEllipsoid reports them). Throws
+/// std::runtime_error when the whole record cannot calibrate.
+MagCalibration FitRecursive(const std::vector<MagSample>& samples, double field_uT, std::size_t block,
+                            const std::function<void(const RecursiveMagStep&)>& on_step);
+
+/// convergence.csv of `calibrate-mag --method recursive --run_dir`: `samples,t_s,
+/// hard_iron_x_uT,hard_iron_y_uT,hard_iron_z_uT,field_uT`, nan while not determined.
+void WriteMagConvergenceCsv(std::ostream& out, const std::vector<RecursiveMagStep>& steps);
 
 struct PlanarFitOptions {
   MagLoss loss = MagLoss::kCauchy;

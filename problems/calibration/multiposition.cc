@@ -725,6 +725,22 @@ ImuCalibrationResult CalibrateMultiPositionRecord(const std::string& record_path
   return CalibrateMultiPosition(ReadMultiPositionData(root, base_dir), ReadMultiPositionOptions(root));
 }
 
+ImuCalibrationResult CalibrateMultiPositionRecordRecursive(
+    const std::string& record_path, const std::function<void(const ImuCalibrationResult&)>& on_position) {
+  const ConfigNode root = LoadYamlFile(record_path);
+  const std::string base_dir = std::filesystem::path(record_path).parent_path().string();
+  RecursiveMultiPosition filter(ReadMultiPositionData(root, base_dir), ReadMultiPositionOptions(root));
+  ImuCalibrationResult current;
+  while (filter.Step()) {
+    current = filter.Current();
+    if (on_position) on_position(current);
+  }
+  if (filter.positions_done() == 0) {
+    throw std::runtime_error("recursive multi-position calibration: the record has no static position");
+  }
+  return current;
+}
+
 MultiPositionOptions ReadMultiPositionOptions(const ConfigNode& node) {
   MultiPositionOptions options;
   options.settle_s = node.NonNegative("settle_s", options.settle_s);

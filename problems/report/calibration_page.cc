@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "core/io/input_error.h"
 #include "core/units.h"
@@ -168,6 +169,106 @@ Figure ImuResidualFigure(const std::vector<AlignmentFolder>& folders, const std:
   return f;
 }
 
+/// convergence.csv of a recursive calibration, when the folder has one: x (positions or
+/// samples) and per requested column its values (and σ, NaN where the file has none).
+struct Convergence {
+  const AlignmentFolder* folder = nullptr;
+  std::vector<double> x;
+  std::vector<std::vector<double>> value, sigma;
+};
+
+/// The columns: (name, unit) pairs, read as "<name>_<unit>" and "<name>_sigma_<unit>".
+std::optional<Convergence> LoadConvergence(const AlignmentFolder& f, const std::string& x_column,
+                                           const std::vector<std::pair<std::string, std::string>>& columns,
+                                           bool with_sigma) {
+  const std::string path = f.dir + "/convergence.csv";
+  if (!std::filesystem::is_regular_file(path)) return std::nullopt;
+  std::vector<CsvColumn> request = {{x_column}};
+  for (const auto& [name, unit] : columns) {
+    request.push_back({name + "_" + unit});
+    if (with_sigma) request.push_back({name + "_sigma_" + unit});
+  }
+  const CsvTable csv(path, request);
+  Convergence out{&f, csv.number(0), {}, {}};
+  const std::size_t stride = with_sigma ? 2 : 1;
+  for (std::size_t k = 0; k < columns.size(); ++k) {
+    out.value.push_back(csv.number(1 + stride * k));
+    out.sigma.push_back(with_sigma ? csv.number(2 + stride * k) : std::vector<double>(csv.rows(), NAN));
+  }
+  return out;
+}
+
+bool AnyFinite(const std::vector<double>& v) {
+  return std::any_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+}
+
+/// Panels of convergence: panel p draws columns [3p, 3p + 3) (x, y, z) of every folder's
+/// convergence, with ±3σ bands where σ is known. A series without a finite value is left
+/// out, a panel without any (a block never estimated) too, with its name in `left_out`.
+Figure ConvergenceFigure(const std::vector<AlignmentFolder>& folders, const std::vector<Convergence>& data,
+                         const std::vector<std::string>& panel_labels, const std::string& x_label, Figure f,
+                         std::vector<std::string>* left_out) {
+  static const char* const kAxis[3] = {"x", "y", "z"};
+  std::vector<std::string> panels;
+  for (std::size_t p = 0; p < panel_labels.size(); ++p) {
+    std::string plots;
+    for (std::size_t d = 0; d < data.size(); ++d) {
+      for (std::size_t a = 0; a < 3; ++a) {
+        const std::size_t c = 3 * p + a;
+        if (!AnyFinite(data[d].value[c])) continue;
+        const std::string name = "c" + std::to_string(p) + "_" + std::to_string(d) + "_" + std::to_string(a);
+        AppendDatablock(&f.script, name, {data[d].x, data[d].value[c], data[d].sigma[c]});
+        const std::string who = Who(folders, *data[d].folder);
+        const std::string color = SeriesColor(3 * d + a);
+        if (AnyFinite(data[d].sigma[c])) {
+          plots += (plots.empty() ? "" : ", ") + std::string("$") + name +
+                   " u 1:($2-3*$3):($2+3*$3) w filledcurves fc rgb '" + color +
+                   "' fs transparent solid 0.15 noborder notitle";
+          ++f.series;
+        }
+        plots += (plots.empty() ? "" : ", ") + std::string("$") + name + " u 1:2 w lp pt 7 ps 0.6 lw 1.3 lc rgb '" +
+                 color + "' title " + GnuplotQuote((who.empty() ? "" : who + " ") + kAxis[a]);
+        ++f.series;
+      }
+    }
+    if (plots.empty()) {
+      left_out->push_back(f.title + ": " + panel_labels[p] + " not estimated in any folder");
+      continue;
+    }
+    panels.push_back("set ylabel " + GnuplotQuote(panel_labels[p]) + "\nplot " + plots + "\n");
+  }
+  f.height_px = 260 * static_cast<int>(std::max<std::size_t>(panels.size(), 1)) + 60;
+  f.script += GnuplotCommon() + "set multiplot layout " + std::to_string(panels.size()) + ",1\nset lmargin 12\n" +
+              "set xlabel " + GnuplotQuote(x_label) + "\n";
+  for (const std::string& panel : panels) f.script += panel;
+  f.script += "unset multiplot\n";
+  return f;
+}
+
+void ImuConvergenceFigure(const std::vector<AlignmentFolder>& folders, FigureSet* out) {
+  std::vector<std::pair<std::string, std::string>> columns;
+  const std::pair<const char*, const char*> blocks[4] = {
+      {"accel.bias.", "mg"}, {"gyro.bias.", "deg_h"}, {"accel.scale_factor.", "ppm"}, {"gyro.scale_factor.", "ppm"}};
+  for (const auto& [block, unit] : blocks) {
+    for (const char* axis : {"x", "y", "z"}) columns.emplace_back(block + std::string(axis), unit);
+  }
+  std::vector<Convergence> data;
+  for (const AlignmentFolder& f : folders) {
+    if (std::optional<Convergence> c = LoadConvergence(f, "positions", columns, true)) data.push_back(std::move(*c));
+  }
+  if (data.empty()) return;  // no recursive run among the folders
+  Figure f;
+  f.id = "recursive_convergence";
+  f.title = "Recursive estimate after each position";
+  f.caption = "The recursive multi-position calibration (calibrate-imu --method recursive, convergence.csv): the "
+              "biases and scale factors after each static position with their ±3σ bands; a parameter appears once "
+              "the positions so far observe it (until then it is held at 0 and the others' σ are conditional on that).";
+  Figure drawn = ConvergenceFigure(
+      folders, data, {"accel bias [mg]", "gyro bias [deg/h]", "accel scale factor [ppm]", "gyro scale factor [ppm]"},
+      "static positions", std::move(f), &out->left_out);
+  if (drawn.series > 0) out->figures.push_back(std::move(drawn));
+}
+
 // ------------------------------------------------------------------------- magnetometer
 
 struct MagFolder {
@@ -271,6 +372,7 @@ PageParts CalibrationPage(const std::vector<AlignmentFolder>& folders, std::size
         ImuSummaryTable(data) + ImuParameterTable(folders, data));
     page.figures.figures.push_back(ImuResidualFigure(folders, data, false));
     page.figures.figures.push_back(ImuResidualFigure(folders, data, true));
+    ImuConvergenceFigure(folders, &page.figures);
     return page;
   }
   std::vector<MagFolder> data;
@@ -282,6 +384,23 @@ PageParts CalibrationPage(const std::vector<AlignmentFolder>& folders, std::size
       "(<code>navtwin calibrate-mag --run_dir</code>).",
       MagTables(data));
   page.figures.figures.push_back(MagFieldFigure(folders, data, max_points));
+  std::vector<Convergence> convergence;
+  for (const AlignmentFolder& f : folders) {
+    if (std::optional<Convergence> c = LoadConvergence(
+            f, "samples", {{"hard_iron_x", "uT"}, {"hard_iron_y", "uT"}, {"hard_iron_z", "uT"}}, false)) {
+      convergence.push_back(std::move(*c));
+    }
+  }
+  if (!convergence.empty()) {
+    Figure f;
+    f.id = "recursive_convergence";
+    f.title = "Recursive hard-iron estimate";
+    f.caption = "The recursive ellipsoid fit (calibrate-mag --method recursive, convergence.csv): the hard iron after "
+                "every 1/20 of the samples (no σ: the recursive fit gives none; gaps where it could not yet estimate).";
+    Figure drawn =
+        ConvergenceFigure(folders, convergence, {"hard iron [uT]"}, "samples", std::move(f), &page.figures.left_out);
+    if (drawn.series > 0) page.figures.figures.push_back(std::move(drawn));
+  }
   return page;
 }
 

@@ -2,7 +2,9 @@
 // the issue-8 evidence that a calibration applied with `--calibration` makes a GNSS/INS run
 // of the same IMU better (docs/calibration/compensation.sh runs that sequence for three
 // seeds and the smoothers; docs/calibration-imu.md has the table).
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -96,6 +98,36 @@ TEST(CalibrateImuTest, RunFolderAndReport) {
   const RunResult usage = Navtwin(base + " --report");
   EXPECT_EQ(usage.exit_code, 2);
   EXPECT_NE(usage.err.find("--run_dir"), std::string::npos) << usage.err;
+}
+
+// --method recursive: one line per static position on stdout, convergence.csv with a row
+// per position, and the same final estimate as the batch (within 1e-3 sigma, the library
+// test's bound: both solve the same equations).
+TEST(CalibrateImuTest, RecursiveMethodPrintsEveryPositionAndEndsAtTheBatch) {
+  const std::string dir = MakeTempDir("calibrate_recursive");
+  ASSERT_EQ(Navtwin("simulate --scenario " + kDocs + "table-mems.yaml --seed 3 --out " + dir + "/table").exit_code, 0);
+  WriteRecord(dir + "/record.yaml", dir + "/table/imu.txt");
+  const std::string base = "calibrate-imu --rig multiposition --data " + dir + "/record.yaml";
+  const RunResult batch = Navtwin(base + " --format=json");
+  ASSERT_EQ(batch.exit_code, 0) << batch.err;
+  const RunResult rec = Navtwin(base + " --method recursive --run_dir " + dir + "/run");
+  ASSERT_EQ(rec.exit_code, 0) << rec.err;
+  const int positions = static_cast<int>(JsonNumberAfter(batch.out, "{", "positions"));
+  ASSERT_GT(positions, 6);
+  for (int k = 1; k <= positions; ++k) {
+    char prefix[16];
+    std::snprintf(prefix, sizeof prefix, "\n%3d ", k);
+    EXPECT_NE(rec.out.find(prefix), std::string::npos) << "position " << k << "\n" << rec.out;
+  }
+  EXPECT_EQ(Occurrences(ReadAll(dir + "/run/convergence.csv"), "\n"), static_cast<std::size_t>(positions + 1));
+  const RunResult rec_json = Navtwin(base + " --method recursive --format=json");
+  ASSERT_EQ(rec_json.exit_code, 0) << rec_json.err;
+  for (const char* name : {"accel.bias.x", "gyro.scale_factor.z", "accel.misalignment.yz"}) {
+    const std::string anchor = std::string("\"") + name + "\"";
+    const double b = JsonNumberAfter(batch.out, anchor, "value"), r = JsonNumberAfter(rec_json.out, anchor, "value");
+    EXPECT_NEAR(r, b, 1e-3 * JsonNumberAfter(batch.out, anchor, "sigma")) << name;
+  }
+  EXPECT_EQ(Navtwin("calibrate-imu --rig pendulum --data " + dir + "/record.yaml --method recursive").exit_code, 2);
 }
 
 TEST(CalibrateImuTest, PendulumRecordFromSimulatedMountings) {

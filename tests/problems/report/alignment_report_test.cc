@@ -115,7 +115,7 @@ class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
   }
   /// A calibrate-imu folder written by the command's writers: 8 positions whose raw errors
   /// are 5 mg / 100 deg/h, 0.01 mg / 1 deg/h after.
-  std::string ImuCalibrationFolder(const std::string& name) {
+  std::string ImuCalibrationFolder(const std::string& name, bool recursive = false) {
     calibration::ImuCalibrationResult r;
     r.calibration.accel(9) = 0.05;
     r.calibration.accel_sigma = Eigen::Matrix<double, kTriadParameters, 1>::Constant(1e-4);
@@ -132,10 +132,15 @@ class AlignmentReportTest : public navtwin::testing::ScratchDirTest {
     }
     CalibrationFile file;
     file.imu = r.calibration;
+    std::vector<calibration::RunFolderFile> files = {
+        {"parameters.csv", [&r](std::ostream& o) { calibration::WriteImuParametersCsv(o, r); }},
+        {"residuals.csv", [&r](std::ostream& o) { calibration::WriteImuResidualsCsv(o, r); }}};
+    const std::vector<calibration::ImuCalibrationResult> steps(3, r);  // a recursive run's estimates
+    if (recursive) {
+      files.push_back({"convergence.csv", [&steps](std::ostream& o) { calibration::WriteImuConvergenceCsv(o, steps); }});
+    }
     calibration::WriteCalibrationRunFolder(
-        dir_ + "/" + name, calibration::ImuCalibrationJson(r, "multiposition", "calibrate-imu"), file,
-        {{"parameters.csv", [&r](std::ostream& o) { calibration::WriteImuParametersCsv(o, r); }},
-         {"residuals.csv", [&r](std::ostream& o) { calibration::WriteImuResidualsCsv(o, r); }}});
+        dir_ + "/" + name, calibration::ImuCalibrationJson(r, "multiposition", "calibrate-imu"), file, files);
     return dir_ + "/" + name;
   }
   /// A calibrate-mag folder: 400 samples of a turning sensor with 10 uT of hard iron.
@@ -314,6 +319,11 @@ TEST_F(AlignmentReportTest, CalibrationPagesShowResidualsBeforeAndAfter) {
   for (const char* text : {"accel.bias.x", "cal_b value", "multiposition", "<td>8</td>"}) {
     EXPECT_NE(html.find(text), std::string::npos) << text;
   }
+  // A recursive run's folder adds the convergence: the two accelerometer panels x 3 axes x
+  // (band + line); the gyro blocks have no σ here (not estimated): left out, and said.
+  const std::string rec = Report({ImuCalibrationFolder("cal_r", true)});
+  ExpectFigures(rec, {{"accel_residuals", 2}, {"gyro_residuals", 2}, {"recursive_convergence", 12}});
+  EXPECT_NE(rec.find("gyro bias [deg/h] not estimated in any folder"), std::string::npos);
   const std::string mag = Report({MagCalibrationFolder("mag")});
   ExpectFigures(mag, {{"mag_field", 2}});
   EXPECT_NE(mag.find("10.000 (0.100)"), std::string::npos);
