@@ -5,9 +5,12 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
+#include <vector>
 
 #include "core/rotation.h"
+#include "core/sim/random.h"
 #include "core/units.h"
 
 namespace navtwin::sim {
@@ -111,6 +114,25 @@ MultiPositionConfig ParseMultiPosition(const ConfigNode& node) {
   return c;
 }
 
+/// A [min, max] pair of seconds (0 < min <= max) from `key`, or the default.
+std::pair<double, double> SecondsRange(const ConfigNode& node, const std::string& key, std::pair<double, double> range) {
+  const Eigen::Vector2d v = node.Range(key, Eigen::Vector2d(range.first, range.second));
+  if (!(v[0] > 0.0)) node.Fail(key, "expected [min, max] seconds with 0 < min <= max");
+  return {v[0], v[1]};
+}
+
+HandheldConfig ParseHandheld(const ConfigNode& node) {
+  node.RequireKeys({"kind", "positions", "initial_still_s", "still_s", "turn_s", "max_pitch_deg", "placement_seed"});
+  HandheldConfig c;
+  c.positions = node.Int("positions", c.positions, 1, 1000);
+  c.initial_still_s = node.NonNegative("initial_still_s", c.initial_still_s);
+  std::tie(c.still_min_s, c.still_max_s) = SecondsRange(node, "still_s", {c.still_min_s, c.still_max_s});
+  std::tie(c.turn_min_s, c.turn_max_s) = SecondsRange(node, "turn_s", {c.turn_min_s, c.turn_max_s});
+  c.max_pitch_rad = node.Double("max_pitch_deg", c.max_pitch_rad * kRadToDeg, 0.0, 89.0) * kDegToRad;
+  c.placement_seed = static_cast<std::uint64_t>(node.Double("placement_seed", 1.0, 0.0, 1e15));
+  return c;
+}
+
 PendulumConfig ParsePendulum(const ConfigNode& node) {
   node.RequireKeys({"kind", "length_m", "damping_per_s", "c2_per_s2", "initial_angle_deg",
                     "initial_rate_deg_s", "mounting", "mounting_deg", "angle_noise_deg",
@@ -168,6 +190,10 @@ CalibrationRigConfig ParseCalibrationRigConfig(const ConfigNode& node) {
   if (kind == "multiposition") {
     c.kind = CalibrationRigConfig::Kind::kMultiPosition;
     c.table = ParseMultiPosition(node);
+  } else if (kind == "handheld") {
+    c.kind = CalibrationRigConfig::Kind::kHandheld;
+    c.handheld = ParseHandheld(node);
+    c.table = HandheldSchedule(c.handheld);
   } else if (kind == "pendulum") {
     c.kind = CalibrationRigConfig::Kind::kPendulum;
     c.pendulum = ParsePendulum(node);
@@ -177,7 +203,7 @@ CalibrationRigConfig ParseCalibrationRigConfig(const ConfigNode& node) {
       node.Fail("", e.what());
     }
   } else {
-    node.Fail("kind", "expected multiposition or pendulum, got '" + kind + "'");
+    node.Fail("kind", "expected multiposition, pendulum or handheld, got '" + kind + "'");
   }
   return c;
 }
@@ -187,6 +213,35 @@ std::unique_ptr<CalibrationRig> MakeCalibrationRig(const CalibrationRigConfig& c
     return std::make_unique<PendulumRig>(config.pendulum);
   }
   return std::make_unique<MultiPositionRig>(config.table);
+}
+
+MultiPositionConfig HandheldSchedule(const HandheldConfig& config) {
+  if (config.positions < 1 || !(config.still_min_s > 0.0) || !(config.still_max_s >= config.still_min_s) ||
+      !(config.turn_min_s > 0.0) || !(config.turn_max_s >= config.turn_min_s) || !(config.initial_still_s >= 0.0)) {
+    throw std::invalid_argument("HandheldSchedule: needs positions >= 1 and 0 < min <= max for still_s and turn_s");
+  }
+  Rng rng = Rng(config.placement_seed).Stream("handheld");
+  const double max_sin_pitch = std::sin(config.max_pitch_rad);
+  MultiPositionConfig table;
+  table.rotation_s = config.turn_min_s;
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();
+  for (int k = 0; k <= config.positions; ++k) {
+    TableStep step;
+    // Roll and yaw uniform, sin(pitch) uniform: gravity uniform over the body directions.
+    const Eigen::Vector3d target(rng.Uniform(-M_PI, M_PI), std::asin(rng.Uniform(-max_sin_pitch, max_sin_pitch)),
+                                 rng.Uniform(-M_PI, M_PI));
+    if (k > 0) {
+      // The short way round in roll and yaw.
+      step.euler_rad = Eigen::Vector3d(e.x() + WrapPi(target.x() - e.x()), target.y(), e.z() + WrapPi(target.z() - e.z()));
+      step.move_s = rng.Uniform(config.turn_min_s, config.turn_max_s);
+    } else {
+      step.euler_rad = target;
+    }
+    step.dwell_s = k == 0 ? config.initial_still_s : rng.Uniform(config.still_min_s, config.still_max_s);
+    e = step.euler_rad;
+    table.steps.push_back(step);
+  }
+  return table;
 }
 
 // -------------------------------------------------------- multi-position table
@@ -203,8 +258,8 @@ MultiPositionRig::MultiPositionRig(const MultiPositionConfig& config) {
     const TableStep& step = config.steps[i];
     if (!(step.dwell_s >= 0.0)) throw std::invalid_argument("MultiPositionRig: dwell_s < 0");
     if (step.kind == TableStep::Kind::kPosition && i > 0) {
-      segments_.push_back(
-          {Segment::Kind::kMove, t, t + config.rotation_s, e, step.euler_rad, 2, 0.0, 0.0});
+      const double move_s = step.move_s > 0.0 ? step.move_s : config.rotation_s;
+      segments_.push_back({Segment::Kind::kMove, t, t + move_s, e, step.euler_rad, 2, 0.0, 0.0});
       e = step.euler_rad;
     } else if (step.kind == TableStep::Kind::kRotation) {
       if (!(step.ramp_s > 0.0) || !(step.duration_s >= 0.0)) {

@@ -19,6 +19,7 @@
 // attitude agree to rounding; the angle itself follows the ODE to ~1e-12 rad.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -42,6 +43,7 @@ struct TableStep {
   double duration_s = 0.0;  ///< rotation: time at the constant rate
   double ramp_s = 1.0;      ///< rotation: spin-up time and spin-down time (> 0)
   double dwell_s = 0.0;     ///< hold after the step
+  double move_s = 0.0;      ///< position: time of the move to it (0: the schedule's rotation_s)
 };
 
 struct MultiPositionConfig {
@@ -64,15 +66,38 @@ struct PendulumConfig {
   double angle_quantum_rad = 0.0;
 };
 
-struct CalibrationRigConfig {
-  enum class Kind { kMultiPosition, kPendulum };
-  Kind kind = Kind::kMultiPosition;
-  MultiPositionConfig table;
-  PendulumConfig pendulum;
+/// A sensor put down by hand in random orientations (no rig, no known attitudes): held
+/// still for initial_still_s, then `positions` times turned by hand (a smooth turn of
+/// random length in [turn_min_s, turn_max_s] along the straight line in Euler angles, the
+/// short way round) to a random attitude and held still for a random time in
+/// [still_min_s, still_max_s]. The attitudes put gravity uniformly over the sphere of body
+/// directions within |pitch| <= max_pitch (roll and yaw uniform, sin(pitch) uniform). The
+/// placements are drawn from placement_seed (part of the scenario, like a table's
+/// schedule: `simulate --seed` draws the sensor errors and noise, not the placements). No
+/// translation: a hand's lifts do not matter to the gyro integration between still
+/// intervals, and the accelerometer is used only when still.
+struct HandheldConfig {
+  int positions = 15;
+  double initial_still_s = 30.0;
+  double still_min_s = 2.0, still_max_s = 5.0;
+  double turn_min_s = 1.0, turn_max_s = 3.0;
+  double max_pitch_rad = 80.0 * 0.017453292519943295;
+  std::uint64_t placement_seed = 1;
 };
 
-/// Parses `trajectory: {kind: multiposition, ...}` or `{kind: pendulum, ...}` (schema in
-/// docs/aiding-models.md). Throws InputError naming the file, line and key.
+/// The table schedule of a hand-placed sequence (HandheldConfig above).
+MultiPositionConfig HandheldSchedule(const HandheldConfig& config);
+
+struct CalibrationRigConfig {
+  enum class Kind { kMultiPosition, kPendulum, kHandheld };
+  Kind kind = Kind::kMultiPosition;
+  MultiPositionConfig table;  ///< kMultiPosition; kHandheld: HandheldSchedule(handheld)
+  PendulumConfig pendulum;
+  HandheldConfig handheld;
+};
+
+/// Parses `trajectory: {kind: multiposition, ...}`, `{kind: pendulum, ...}` or
+/// `{kind: handheld, ...}` (schema in docs/aiding-models.md). Throws InputError naming the file, line and key.
 CalibrationRigConfig ParseCalibrationRigConfig(const ConfigNode& node);
 
 /// The IMU mounting on a pendulum's bob, R_p_b, from the keys of `node`: `mounting`

@@ -45,9 +45,11 @@ Scenario ParseScenario(const ConfigNode& root) {
   const ConfigNode trajectory = root.Child("trajectory");
   const std::string kind = trajectory.String("kind", "segments");
   double trajectory_duration_s = 0.0;
-  if (kind == "multiposition" || kind == "pendulum") {
+  if (kind == "multiposition" || kind == "pendulum" || kind == "handheld") {
     std::shared_ptr<CalibrationRig> rig = MakeCalibrationRig(ParseCalibrationRigConfig(trajectory));
     s.emit_trajectory = [rig](YAML::Emitter& out) { rig->EmitDrawn(out); };
+    // A schedule's own length is the default duration (a hand-placed sequence's is drawn).
+    if (const auto* table = dynamic_cast<const MultiPositionRig*>(rig.get())) trajectory_duration_s = table->duration_s();
     s.trajectory = rig;
   } else if (kind == "segments") {
     auto segments = std::make_shared<SegmentTrajectory>(ParseTrajectoryConfig(trajectory));
@@ -55,7 +57,7 @@ Scenario ParseScenario(const ConfigNode& root) {
     s.trajectory = segments;
   } else {
     trajectory.Fail("kind", "unknown trajectory kind '" + kind +
-                                "' (segments, multiposition, pendulum)");
+                                "' (segments, multiposition, pendulum, handheld)");
   }
   s.duration_s = root.Double("duration_s", trajectory_duration_s, 0.0, 30.0 * kSecondsPerDay);
   if (!(s.duration_s > 0.0)) root.Fail("duration_s", "required (> 0) for this trajectory kind");
