@@ -12,6 +12,9 @@
 #include "core/sim/analytic_trajectory.h"
 #include "core/sim/inertial_errors.h"
 #include "core/sim/random.h"
+#include "core/earth.h"
+#include "core/sim/calibration_rig.h"
+#include "problems/calibration/handheld.h"
 #include "problems/calibration/multiposition.h"
 #include "core/units.h"
 
@@ -78,6 +81,53 @@ void BM_RecursiveMultiPosition(benchmark::State& state) {
   state.counters["positions"] = r.positions;
 }
 BENCHMARK(BM_RecursiveMultiPosition)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The hand-placed calibration (problems/calibration/handheld.h) of a 30-minute 100 Hz
+// record: 30 s still, then 327 hand placements (2-5 s still, 1-3 s turns) of a MEMS IMU
+// (300 deg/h, 6 mg biases, 4000 ppm scale factors, 2 mrad misalignments; 0.3 deg/sqrt(h),
+// 0.05 m/s/sqrt(h)). The goal: <= 5 s.
+const HandheldData& HandheldRecord() {
+  static const HandheldData data = [] {
+    sim::HandheldConfig h;
+    h.positions = 327;
+    const sim::MultiPositionRig rig(sim::HandheldSchedule(h));
+    sim::InertialErrorConfig c;
+    c.gyro.bias.sigma = 300.0 * kDegPerHour_radps;
+    c.gyro.white_noise = 0.3 * kDegPerSqrtHour_radpsqrts;
+    c.gyro.scale_factor.sigma = 4000e-6;
+    c.gyro.misalignment.sigma = 2e-3;
+    c.accel.bias.sigma = 6.0 * kMilliG_mps2;
+    c.accel.white_noise = 0.05 * kMpsPerSqrtHour_mpspsqrts;
+    c.accel.scale_factor.sigma = 4000e-6;
+    c.accel.misalignment.sigma = 2e-3;
+    sim::InertialErrorModel model(c, sim::Rng(1).Stream("imu"), false);
+    HandheldData d;
+    d.latitude_rad = 37.45 * kDegToRad;
+    d.height_m = 300.0;
+    sim::SynthesizeImu(rig, wgs84::Geodetic{d.latitude_rad, 0.0, d.height_m}, 100.0, rig.duration_s(),
+                       [&](const ImuSample& s, const NavState&) {
+                         if (s.dt_s <= 0.0) return;
+                         ImuSample m = s;
+                         model.Apply(s.t_s, s.dt_s, 25.0, s.dtheta_b_rad, s.dv_b_mps, &m.dtheta_b_rad, &m.dv_b_mps);
+                         d.imu.push_back(m);
+                       });
+    return d;
+  }();
+  return data;
+}
+
+void BM_Handheld30Min(benchmark::State& state) {
+  const HandheldData& data = HandheldRecord();
+  int intervals = 0;
+  for (auto _ : state) {
+    StillDetection detection;
+    benchmark::DoNotOptimize(CalibrateHandheld(data, {}, &detection));
+    intervals = detection.intervals;
+  }
+  state.counters["record_s"] = data.imu.back().t_s - data.imu.front().t_s;
+  state.counters["still_intervals"] = intervals;
+}
+BENCHMARK(BM_Handheld30Min)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
 }  // namespace navtwin::calibration

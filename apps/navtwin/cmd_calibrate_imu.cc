@@ -5,6 +5,7 @@
 // IMU reader applies with --calibration.
 #include <gflags/gflags.h>
 
+#include <cmath>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -13,10 +14,17 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
+#include "core/io/open.h"
+#include "core/units.h"
 #include "problems/calibration/calibration_run_folder.h"
+#include "problems/calibration/handheld.h"
 #include "problems/calibration/imu_calibration.h"
 
-DEFINE_string(rig, "", "calibrate-imu: multiposition, pendulum or temperature (what --data records)");
+DEFINE_string(rig, "",
+              "calibrate-imu: multiposition, pendulum or temperature (what --data records), or handheld (--imu)");
+DEFINE_double(latitude_deg, NAN, "calibrate-imu --rig handheld: latitude of the place, deg (local gravity)");
+DEFINE_double(height_m, 0.0, "calibrate-imu --rig handheld: ellipsoidal height of the place, m (local gravity)");
+DEFINE_double(initial_still_s, 30.0, "calibrate-imu --rig handheld: the still period at the start of the record, s");
 
 namespace navtwin::app {
 
@@ -33,7 +41,12 @@ int Usage(const std::string& why) {
 /// The command line as one string, for the file's created_by.
 std::string CommandLine() {
   std::ostringstream s;
-  s << "navtwin calibrate-imu --rig " << FLAGS_rig << " --data " << FLAGS_data;
+  s << "navtwin calibrate-imu --rig " << FLAGS_rig;
+  if (FLAGS_rig == "handheld") {
+    s << " --imu " << FLAGS_imu << " --latitude_deg " << FLAGS_latitude_deg << " --height_m " << FLAGS_height_m;
+  } else {
+    s << " --data " << FLAGS_data;
+  }
   if (FLAGS_method == "recursive") s << " --method recursive";
   return s.str();
 }
@@ -47,6 +60,16 @@ calibration::ImuCalibrationResult Calibrate(bool recursive, std::vector<calibrat
           if (FLAGS_format == "text") std::cout << calibration::RecursiveStepText(estimate, steps->empty());
           steps->push_back(estimate);
         });
+  }
+  if (FLAGS_rig == "handheld") {
+    calibration::HandheldData data;
+    data.imu_path = FLAGS_imu;
+    data.imu = ReadAll(*OpenImu(FLAGS_imu, FLAGS_calibration, FLAGS_imu_temperature_degC));
+    data.latitude_rad = FLAGS_latitude_deg * kDegToRad;
+    data.height_m = FLAGS_height_m;
+    calibration::HandheldOptions options;
+    options.initial_still_s = FLAGS_initial_still_s;
+    return calibration::CalibrateHandheld(data, options);
   }
   if (FLAGS_rig == "multiposition") return calibration::CalibrateMultiPositionRecord(FLAGS_data);
   if (FLAGS_rig == "pendulum") return calibration::CalibratePendulumRecord(FLAGS_data);
@@ -71,12 +94,20 @@ void WriteRunFolder(const calibration::ImuCalibrationResult& result, const Calib
 
 int RunCalibrateImu(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args.front() + "' (the record goes in --data)");
-  if (FLAGS_data.empty()) return Usage("--data RECORD is required");
+  if (FLAGS_rig == "handheld") {
+    if (FLAGS_imu.empty()) return Usage("--rig handheld reads --imu FILE");
+    if (!std::isfinite(FLAGS_latitude_deg) || std::abs(FLAGS_latitude_deg) > 90.0) {
+      return Usage("--rig handheld needs --latitude_deg (the place's latitude, for the local gravity)");
+    }
+    if (!(FLAGS_initial_still_s > 0.0)) return Usage("--initial_still_s must be > 0");
+  } else if (FLAGS_data.empty()) {
+    return Usage("--data RECORD is required");
+  }
   if (FLAGS_format != "text" && FLAGS_format != "json") return Usage("--format must be text or json");
   if (FLAGS_report && FLAGS_run_dir.empty()) return Usage("--report needs --run_dir DIR (it writes DIR/report.html)");
-  if (FLAGS_rig.empty()) return Usage("--rig is required: multiposition, pendulum or temperature");
-  if (FLAGS_rig != "multiposition" && FLAGS_rig != "pendulum" && FLAGS_rig != "temperature") {
-    return Usage("unknown --rig '" + FLAGS_rig + "': multiposition, pendulum or temperature");
+  if (FLAGS_rig.empty()) return Usage("--rig is required: multiposition, pendulum, temperature or handheld");
+  if (FLAGS_rig != "multiposition" && FLAGS_rig != "pendulum" && FLAGS_rig != "temperature" && FLAGS_rig != "handheld") {
+    return Usage("unknown --rig '" + FLAGS_rig + "': multiposition, pendulum, temperature or handheld");
   }
   const std::string method = FLAGS_method.empty() ? "batch" : FLAGS_method;
   if (method != "batch" && method != "recursive") return Usage("--method must be batch or recursive");
@@ -114,6 +145,9 @@ Command CalibrateImuCommand() {
           "  - temperature: {order, latitude_deg, height_m, runs: [{temperature_degC, imu, trajectory}]},\n"
           "    one multi-position schedule per chamber temperature, or warm-up runs with\n"
           "    temperature: FILE (t_s,temperature_degC) instead (docs/calibration-temperature.md).\n"
+          "  - handheld (no rig; --imu FILE --latitude_deg L [--height_m H] [--initial_still_s 30]): the\n"
+          "    sensor put down by hand in 10 or more orientations, still 2 s or more each, after a still\n"
+          "    period at the start (docs/calibration-imu.md \"Without a rig\").\n"
           "  Prints every parameter with one sigma and the parameters the data cannot observe (held\n"
           "  at 0); --out writes the calibration file that --calibration applies to IMU readers; --run_dir\n"
           "  the run folder (docs/run-folder.md: summary, calibration file, parameters, residuals before\n"
@@ -123,7 +157,8 @@ Command CalibrateImuCommand() {
           "  the batch does; --run_dir adds convergence.csv, which the report draws.\n"
           "  Exit 1 for records that cannot calibrate (too few positions, a temperature span too\n"
           "  small for the order, ...), with what is missing; nothing is written then.",
-          {"data", "rig", "method", "out", "run_dir", "report"},
+          {"data", "rig", "method", "imu", "calibration", "latitude_deg", "height_m", "initial_still_s", "out", "run_dir",
+           "report"},
           &RunCalibrateImu};
 }
 

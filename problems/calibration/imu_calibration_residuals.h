@@ -90,26 +90,35 @@ struct GyroMove {
   double sigma_rad = 1.0;                                ///< of each component of r
 };
 
+/// The rotation of the body over `samples` from the gyro increments compensated with the
+/// parameters (u_k above), two-sample coning corrected: R = Exp(phi_0) ... Exp(phi_{N-1}),
+/// body at the first sample's start -> body at the last's end. G may be zero.
+template <typename T>
+Eigen::Matrix<T, 3, 3> IntegrateCompensatedGyro(const std::vector<ImuSample>& samples, const T* gyro,
+                                                const Eigen::Matrix<T, 3, 3>& G) {
+  using V3 = Eigen::Matrix<T, 3, 1>;
+  const Eigen::Matrix<T, 3, 3> K_inv = TriadMatrix(gyro).inverse();
+  const V3 b = TriadBias(gyro);
+  Eigen::Quaternion<T> q = Eigen::Quaternion<T>::Identity();
+  V3 u_prev = V3::Zero();
+  bool first = true;
+  for (const ImuSample& s : samples) {
+    const V3 u = K_inv * (s.dtheta_b_rad.cast<T>() - G * s.dv_b_mps.cast<T>() - b * T(s.dt_s));
+    const V3 phi = first ? u : V3(u + u_prev.cross(u) / T(12.0));
+    q = q * QuatFromRotVec(phi);
+    u_prev = u;
+    first = false;
+  }
+  return DcmFromQuat(q);
+}
+
 class GyroMoveResidual {
  public:
   explicit GyroMoveResidual(const GyroMove* move) : move_(move) {}
   template <typename T>
   bool operator()(const T* gyro, const T* g9, T* residual) const {
     using V3 = Eigen::Matrix<T, 3, 1>;
-    const Eigen::Matrix<T, 3, 3> K_inv = TriadMatrix(gyro).inverse();
-    const Eigen::Matrix<T, 3, 3> G = GSensitivityMatrix(g9);
-    const V3 b = TriadBias(gyro);
-    Eigen::Quaternion<T> q = Eigen::Quaternion<T>::Identity();
-    V3 u_prev = V3::Zero();
-    bool first = true;
-    for (const ImuSample& s : move_->samples) {
-      const V3 u = K_inv * (s.dtheta_b_rad.cast<T>() - G * s.dv_b_mps.cast<T>() - b * T(s.dt_s));
-      const V3 phi = first ? u : V3(u + u_prev.cross(u) / T(12.0));
-      q = q * QuatFromRotVec(phi);
-      u_prev = u;
-      first = false;
-    }
-    const Eigen::Matrix<T, 3, 3> R = DcmFromQuat(q);
+    const Eigen::Matrix<T, 3, 3> R = IntegrateCompensatedGyro(move_->samples, gyro, GSensitivityMatrix(g9));
     const V3 r = LogSO3(Eigen::Matrix<T, 3, 3>(move_->R_true.cast<T>().transpose() * R));
     for (int i = 0; i < 3; ++i) residual[i] = r(i) / T(move_->sigma_rad);
     return true;

@@ -370,8 +370,14 @@ PageParts CalibrationPage(const std::vector<AlignmentFolder>& folders, std::size
         "before and after calibration; made by <code>navtwin report</code> from the folders' summary.json, "
         "parameters.csv and residuals.csv (<code>navtwin calibrate-imu --run_dir</code>).",
         ImuSummaryTable(data) + ImuParameterTable(folders, data));
-    page.figures.figures.push_back(ImuResidualFigure(folders, data, false));
-    page.figures.figures.push_back(ImuResidualFigure(folders, data, true));
+    if (std::any_of(data.begin(), data.end(), [](const ImuFolder& m) { return !m.accel_before_mg.empty(); })) {
+      page.figures.figures.push_back(ImuResidualFigure(folders, data, false));
+      page.figures.figures.push_back(ImuResidualFigure(folders, data, true));
+    } else {
+      page.figures.left_out.push_back(
+          "Residuals before and after calibration: no static position with a known attitude in any folder (the "
+          "handheld method knows none; its gravity residuals are in the notes)");
+    }
     ImuConvergenceFigure(folders, &page.figures);
     return page;
   }

@@ -130,6 +130,30 @@ TEST(CalibrateImuTest, RecursiveMethodPrintsEveryPositionAndEndsAtTheBatch) {
   EXPECT_EQ(Navtwin("calibrate-imu --rig pendulum --data " + dir + "/record.yaml --method recursive").exit_code, 2);
 }
 
+// --rig handheld: the IMU file alone (no record), the still intervals and the gravity
+// residuals in the notes, the report without the per-position figures; the place is
+// required.
+TEST(CalibrateImuTest, HandheldFromTheImuFile) {
+  const std::string dir = MakeTempDir("calibrate_handheld");
+  ASSERT_EQ(Navtwin("simulate --scenario " + std::string(NAVTWIN_SOURCE_DIR) +
+                    "/data/calibration/handheld/scenario.yaml --seed 2 --out " + dir + "/sim")
+                .exit_code,
+            0);
+  const std::string base = "calibrate-imu --rig handheld --imu " + dir + "/sim/imu.txt";
+  const RunResult r = Navtwin(base + " --latitude_deg 37.45 --height_m 300 --run_dir " + dir + "/run --report");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* text : {"IMU calibration (handheld), 21 positions", "21 still intervals", "gravity magnitude residual",
+                           "gravity direction after 20 turns", "accel.misalignment.xy: a rotation"}) {
+    EXPECT_NE(r.out.find(text), std::string::npos) << text << "\n" << r.out;
+  }
+  const std::string page = ReadAll(dir + "/run/report.html");
+  EXPECT_EQ(Occurrences(page, "<figure"), 0u);
+  EXPECT_NE(page.find("no static position with a known attitude"), std::string::npos);
+  const RunResult no_place = Navtwin(base);
+  EXPECT_EQ(no_place.exit_code, 2);
+  EXPECT_NE(no_place.err.find("--latitude_deg"), std::string::npos) << no_place.err;
+}
+
 TEST(CalibrateImuTest, PendulumRecordFromSimulatedMountings) {
   const std::string dir = MakeTempDir("pendulum_cli");
   std::string record = "latitude_deg: 37.45\nheight_m: 40\nruns:\n";

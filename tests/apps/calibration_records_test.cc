@@ -76,6 +76,15 @@ TEST(CalibrationRecords, ReadmeRunsAsWrittenAndRecoversTheSimulatedErrors) {
                        std::string(rig) + " accel.bias.x.dT1");
   }
 
+  // Handheld: the accelerometer's biases and scale factors are in the sensor's own axes,
+  // comparable with the truth to first order (the 0.5-3 mrad misalignments move them by
+  // ~1e-5, a fifth of their sigma).
+  const YAML::Node hh = YAML::LoadFile(w + "/handheld/sim/errors.yaml")["imu"]["errors"]["accel"];
+  const std::string hh_summary = ReadAll(w + "/handheld/run/summary.json");
+  ExpectWithin4Sigma(Parameter(hh_summary, "accel.bias.y"), hh["bias_ug"][1].as<double>() * kUg, "handheld accel.bias.y");
+  ExpectWithin4Sigma(Parameter(hh_summary, "accel.scale_factor.z"), hh["scale_factor_ppm"][2].as<double>() * kPpm,
+                     "handheld accel.scale_factor.z");
+
   // Magnetometer: the hard iron, and the heading after calibration within 1 deg (noise alone
   // is 0.75 deg RMS: 0.3 uT over the 23 uT horizontal field).
   const std::string mag = ReadAll(w + "/magnetometer/run/summary.json");
