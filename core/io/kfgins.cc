@@ -1,11 +1,13 @@
 #include "core/io/kfgins.h"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <vector>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/rate_to_increment.h"
 #include "core/io/text_line.h"
 #include "core/io/text_reader.h"
@@ -197,6 +199,24 @@ void RequireSigma(const Eigen::Vector3d& s, const char* what) {
   if (!(s.minCoeff() > 0.0)) throw std::invalid_argument(std::string(what) + " must be > 0");
 }
 
+/// A navigation state that cannot be on or near the Earth (core/io/plausibility.h): |lat| >
+/// 90 deg, a height outside [kMinHeight_m, kMaxHeight_m], a speed above kMaxSpeed_mps.
+void RequirePossible(const NavState& s) {
+  const auto refuse = [&](const std::string& what) {
+    std::ostringstream os;
+    os.precision(10);
+    os << "impossible navigation state at t = " << s.t_s << " s: " << what;
+    throw std::invalid_argument(os.str());
+  };
+  if (std::abs(s.lat_rad) > 0.5 * kPi) refuse("latitude " + std::to_string(s.lat_rad * kRadToDeg) + " deg beyond +-90 deg");
+  if (s.h_m < plausible::kMinHeight_m || s.h_m > plausible::kMaxHeight_m) {
+    refuse("height " + std::to_string(s.h_m) + " m outside [-12 km, 1e7 m]");
+  }
+  if (s.v_n_mps.cwiseAbs().maxCoeff() > plausible::kMaxSpeed_mps) {
+    refuse("velocity component above " + std::to_string(plausible::kMaxSpeed_mps) + " m/s");
+  }
+}
+
 void AddTriple(TextLine& line, const Eigen::Vector3d& v) {
   line.Char(' ').Number(v.x()).Char(' ').Number(v.y()).Char(' ').Number(v.z());
 }
@@ -279,8 +299,12 @@ void AppendNavFields(const NavState& s, char separator, TextLine* line) {
   RequireFinite(Eigen::Vector3d(s.lat_rad, s.lon_rad, s.h_m), "navigation position");
   RequireFinite(s.v_n_mps, "navigation velocity");
   RequireFinite(s.q_n_b.coeffs().head<3>(), "attitude quaternion");
+  RequirePossible(s);
+  // Longitude in (-180, 180]: the estimators do not all wrap it (a state past the
+  // antimeridian is possible, its longitude written as the format has it).
+  const double lon_rad = std::abs(s.lon_rad) > kPi ? WrapPi(s.lon_rad) : s.lon_rad;
   const Eigen::Vector3d euler_deg = EulerFromQuat(s.q_n_b) * kRadToDeg;
-  const double fields[10] = {s.t_s,         s.lat_rad * kRadToDeg, s.lon_rad * kRadToDeg, s.h_m,        s.v_n_mps.x(),
+  const double fields[10] = {s.t_s,         s.lat_rad * kRadToDeg, lon_rad * kRadToDeg, s.h_m,        s.v_n_mps.x(),
                              s.v_n_mps.y(), s.v_n_mps.z(),         euler_deg.x(),         euler_deg.y(), euler_deg.z()};
   line->Number(fields[0]);
   for (int i = 1; i < 10; ++i) line->Char(separator).Number(fields[i]);

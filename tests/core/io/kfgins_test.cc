@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/io/open.h"
+#include "core/io/text_line.h"
 #include "core/rotation.h"
 #include "tests/core/io/io_test_util.h"
 
@@ -166,6 +167,59 @@ TEST(KfginsTest, WritersRefuseValuesTheReadersWouldReject) {
   ImuSample s;
   s.dv_b_mps.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(wi.Write(s), std::invalid_argument);
+}
+
+TEST(KfginsTest, NavWriterRefusesImpossibleStates) {
+  NavState ok;
+  ok.t_s = 12.5;
+  ok.lat_rad = 0.5;
+  ok.h_m = 100.0;
+  const auto refused = [](const NavState& s, const std::string& part) {
+    TextLine line;
+    try {
+      AppendNavFields(s, ' ', &line);
+      ADD_FAILURE() << "not refused: " << part;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("t = 12.5 s"), std::string::npos) << e.what();
+    }
+  };
+  NavState s = ok;
+  s.lat_rad = -180.9 * kDegToRad;
+  refused(s, "latitude");
+  s = ok;
+  s.h_m = 7e19;
+  refused(s, "height");
+  s = ok;
+  s.h_m = -4881946.0;
+  refused(s, "height");
+  s = ok;
+  s.v_n_mps.x() = -5.7e9;
+  refused(s, "velocity");
+  // At the limits: written.
+  s = ok;
+  s.lat_rad = -0.5 * kPi;
+  s.h_m = -12e3;
+  TextLine line;
+  AppendNavFields(s, ' ', &line);
+  s.h_m = 1e7;
+  AppendNavFields(s, ' ', &line);
+}
+
+TEST(KfginsTest, NavWriterWrapsTheLongitude) {
+  NavState s;
+  s.lon_rad = 200.0 * kDegToRad;  // past the antimeridian: -160 deg
+  const std::string path = TempFilePath("wrapped.nav");
+  KfginsNavWriter w(path);
+  w.Write(s);
+  s.t_s = 1.0;
+  s.lon_rad = -kPi;  // -180 deg stays as it is
+  w.Write(s);
+  w.Commit();
+  const std::vector<NavState> out = ReadAllSamples(*OpenKfginsNav(path));
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out[0].lon_rad * kRadToDeg, -160.0, 1e-12);
+  EXPECT_NEAR(out[1].lon_rad * kRadToDeg, -180.0, 1e-12);
 }
 
 TEST(KfginsTest, UncommittedWriterLeavesNoFile) {
