@@ -87,9 +87,7 @@ class CsvImuReader final : public ImuReader {
   }
 
   double Value(const UnitColumn& c) const {
-    return ParseDouble(fields_[static_cast<std::size_t>(c.index)], path(), lines_.line_number(),
-                       c.name) *
-           c.scale;
+    return ParseScaled(fields_[static_cast<std::size_t>(c.index)], c.scale, path(), lines_.line_number(), c.name);
   }
   Eigen::Vector3d Triple(int first) const {
     return Eigen::Vector3d(Value(columns_[first]), Value(columns_[first + 1]),

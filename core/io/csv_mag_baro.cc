@@ -48,7 +48,7 @@ class CsvTable {
 
   /// The number in column c times its unit factor.
   double Value(const UnitColumn& c) const {
-    return ParseDouble(Field(c), path(), line(), c.name) * c.scale;
+    return ParseScaled(Field(c), c.scale, path(), line(), c.name);
   }
   /// Like Value, but NaN for an absent column or an empty field.
   double OptionalValue(const UnitColumn& c) const {

@@ -152,6 +152,18 @@ double ParseDouble(std::string_view text, const std::string& path, long line,
   return value;
 }
 
+double ParseScaled(std::string_view text, double scale, const std::string& path, long line,
+                   const std::string& field) {
+  const double value = ParseDouble(text, path, line, field) * scale;
+  if (!std::isfinite(value)) {
+    std::ostringstream os;
+    os << "not a finite number in SI units: " << Quote(text) << " times the unit factor " << scale
+       << " overflows";
+    throw InputError(path, line, field, os.str());
+  }
+  return value;
+}
+
 long long ParseInteger(std::string_view text, const std::string& path, long line,
                        const std::string& field) {
   std::string_view t = text;

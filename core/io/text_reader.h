@@ -67,6 +67,10 @@ void SplitLoose(std::string_view line, std::vector<std::string_view>* fields);
 /// line and field when it is not a number or not finite (nan, inf).
 double ParseDouble(std::string_view text, const std::string& path, long line,
                    const std::string& field);
+/// ParseDouble times `scale` (a unit's factor to SI); throws InputError naming file, line and
+/// field also when the product is not finite (1e308 g is finite, in m/s^2 it is not).
+double ParseScaled(std::string_view text, double scale, const std::string& path, long line,
+                   const std::string& field);
 /// Whole-field decimal integer; throws InputError like ParseDouble.
 long long ParseInteger(std::string_view text, const std::string& path, long line,
                        const std::string& field);

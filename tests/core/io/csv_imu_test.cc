@@ -101,5 +101,15 @@ TEST(CsvImuTest, BadRowsNameLineAndField) {
   ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(header_only)); }, {"no samples"});
 }
 
+TEST(CsvImuTest, ValuesThatOverflowInSiUnitsAreRefused) {
+  // 1e308 g is finite, 1e308 g * 9.80665 m/s^2 per g is not: checked after the scaling.
+  const std::string head = "t_s,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,acc_x_g,acc_y_g,acc_z_g\n";
+  const std::string g = WriteTempFile("g.csv", head + "0,0,0,0,0,0,1\n0.01,0,0,0,1e308,0,1\n0.02,0,0,0,0,0,1\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(g)); }, {g, "line 3", "field 'acc_x_g'", "finite"});
+  const std::string ms = WriteTempFile("ms.csv", "t_ms,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
+                                                 "0,0,0,0,0,0,0\n1,0,0,0,0,0,0\n");
+  EXPECT_EQ(ReadAllSamples(*OpenCsvImu(ms)).size(), 2u);
+}
+
 }  // namespace io_csv_imu_test
 }  // namespace navtwin

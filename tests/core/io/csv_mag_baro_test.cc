@@ -117,6 +117,9 @@ TEST(CsvMagBaroTest, BadMagInputNamesFileLineAndField) {
   bad("nan.csv", header + "0,nan,2,3\n", {"line 2", "mx_uT", "not a finite number"});
   bad("back.csv", header + "0,1,2,3\n0.2,1,2,3\n0.1,1,2,3\n",
       {"line 4", "t_s", "does not increase"});
+  // Finite in gauss, infinite in uT (x 100): checked after the scaling.
+  bad("gauss_overflow.csv", "t_s,mx_G,my_G,mz_G\n0,0.2,0,0.4\n0.1,0.2,1e307,0.4\n",
+      {"gauss_overflow.csv", "line 3", "field 'my_G'", "finite"});
 }
 
 TEST(CsvMagBaroTest, BadBaroInputNamesFileLineAndField) {
