@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "core/io/input_error.h"
@@ -190,6 +191,13 @@ void RequirePositive(double value, const std::string& path, long line, const std
   if (!(value > 0.0)) {
     std::ostringstream os;
     os << "must be > 0, got " << value;
+    throw InputError(path, line, field, os.str());
+  }
+  // A subnormal value (below 2.2e-308) is > 0 but has lost its precision, and 1/value^2
+  // (a weight) overflows.
+  if (value < std::numeric_limits<double>::min()) {
+    std::ostringstream os;
+    os << "must be > 0 and not subnormal (below " << std::numeric_limits<double>::min() << "), got " << value;
     throw InputError(path, line, field, os.str());
   }
 }

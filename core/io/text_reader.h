@@ -77,7 +77,7 @@ long long ParseInteger(std::string_view text, const std::string& path, long line
 /// A number that must be a whole number (RTKLIB writes Q and ns as "1.0000000").
 int ParseWholeNumber(std::string_view text, const std::string& path, long line,
                      const std::string& field);
-/// Throws InputError unless value > 0 (standard deviations, intervals).
+/// Throws InputError unless value > 0 and not subnormal (standard deviations, intervals).
 void RequirePositive(double value, const std::string& path, long line, const std::string& field);
 /// Throws InputError unless the line has exactly `expected` fields.
 void RequireFieldCount(std::size_t found, std::size_t expected, const std::string& path, long line);

@@ -222,6 +222,14 @@ TEST(KfginsTest, NavWriterWrapsTheLongitude) {
   EXPECT_NEAR(out[1].lon_rad * kRadToDeg, -180.0, 1e-12);
 }
 
+TEST(KfginsTest, SubnormalSigmaIsRefused) {
+  const std::string path = WriteTempFile("denormal_sigma.txt",
+                                         "100.0 30.0 114.0 20.0 0.5 0.5 1.0\n"
+                                         "101.0 30.0 114.0 20.0 0.5 1e-320 1.0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(path)); },
+                   {path, "line 2", "field 'sigma_e'", "subnormal"});
+}
+
 TEST(KfginsTest, UncommittedWriterLeavesNoFile) {
   const std::string path = TempFilePath("uncommitted.txt");
   std::remove(path.c_str());
