@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 
 namespace navtwin {
 namespace {
@@ -60,6 +61,7 @@ ScalarSeries ReadScalarSeriesCsv(const std::string& path, std::initializer_list<
     RequireFieldCount(fields.size(), header.size(), path, lines.line_number());
     const double t =
         ParseScaled(fields[static_cast<std::size_t>(time.index)], time.scale, path, lines.line_number(), time.name);
+    plausible::Time(t, path, lines.line_number(), time.name);
     monotonic.Check(t, path, lines.line_number(), time.name);
     const double v = ParseScaled(fields[static_cast<std::size_t>(column.index)], column.scale, path,
                                  lines.line_number(), column.name);

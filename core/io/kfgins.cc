@@ -89,8 +89,46 @@ Eigen::Vector3d Sigmas(const Rows& rows, std::size_t first, const char* x, const
                        const char* z) {
   const Eigen::Vector3d s = Triple(rows, first, x, y, z);
   const char* names[3] = {x, y, z};
-  for (int k = 0; k < 3; ++k) RequirePositive(s[k], rows.path(), rows.line(), names[k]);
+  for (int k = 0; k < 3; ++k) {
+    RequirePositive(s[k], rows.path(), rows.line(), names[k]);
+    plausible::Sigma(s[k], rows.path(), rows.line(), names[k]);
+  }
   return s;
+}
+
+Eigen::Vector3d Velocities(const Rows& rows, std::size_t first, const char* x, const char* y, const char* z) {
+  const Eigen::Vector3d v = Triple(rows, first, x, y, z);
+  const char* names[3] = {x, y, z};
+  for (int k = 0; k < 3; ++k) plausible::Velocity(v[k], rows.path(), rows.line(), names[k]);
+  return v;
+}
+
+/// Time, longitude and height of a GNSS or navigation row (latitude: LatitudeRad).
+double PlausibleTime(const Rows& rows, std::size_t i, const char* field) {
+  const double t = rows.Get(i, field);
+  plausible::Time(t, rows.path(), rows.line(), field);
+  return t;
+}
+double LongitudeRad(const Rows& rows, std::size_t i) {
+  const double lon_rad = rows.Get(i, "lon") * kDegToRad;
+  plausible::Longitude(lon_rad, rows.path(), rows.line(), "lon");
+  return lon_rad;
+}
+double Height(const Rows& rows, std::size_t i) {
+  const double h_m = rows.Get(i, "h");
+  plausible::Height(h_m, rows.path(), rows.line(), "h");
+  return h_m;
+}
+
+/// Increments of an IMU row over dt_s: |dtheta| and |dv| within the full scales of
+/// core/io/plausibility.h times the interval.
+void CheckIncrements(const Rows& rows, const ImuSample& row, double dt_s) {
+  const char* angle[3] = {"dtheta_x", "dtheta_y", "dtheta_z"};
+  const char* velocity[3] = {"dv_x", "dv_y", "dv_z"};
+  for (int k = 0; k < 3; ++k) {
+    plausible::AngleIncrement(row.dtheta_b_rad[k], dt_s, rows.path(), rows.line(), angle[k]);
+    plausible::VelocityIncrement(row.dv_b_mps[k], dt_s, rows.path(), rows.line(), velocity[k]);
+  }
 }
 
 class KfginsImuReader final : public ImuReader {
@@ -100,10 +138,13 @@ class KfginsImuReader final : public ImuReader {
   bool Next(ImuSample* sample) override {
     while (rows_.Next()) {
       ImuSample row;
-      row.t_s = rows_.Get(0, "t");
+      row.t_s = PlausibleTime(rows_, 0, "t");
+      const double dt_s =
+          time_.has_previous() ? row.t_s - time_.previous_s() : plausible::kFirstIncrementInterval_s;
       time_.Check(row.t_s, path(), rows_.line(), "t");
       row.dtheta_b_rad = Triple(rows_, 1, "dtheta_x", "dtheta_y", "dtheta_z");
       row.dv_b_mps = Triple(rows_, 4, "dv_x", "dv_y", "dv_z");
+      CheckIncrements(rows_, row, dt_s);
       if (intervals_.Add(row, sample)) return true;
     }
     if (intervals_.rows() == 0) rows_.ThrowEmpty();
@@ -133,15 +174,15 @@ class KfginsGnssReader final : public GnssReader {
     if (!have_row_ && !rows_.Next()) return false;
     have_row_ = false;
     *s = GnssSample();
-    s->t_s = rows_.Get(0, "t");
+    s->t_s = PlausibleTime(rows_, 0, "t");
     time_.Check(s->t_s, path(), rows_.line(), "t");
     s->lat_rad = LatitudeRad(rows_, 1);
-    s->lon_rad = rows_.Get(2, "lon") * kDegToRad;
-    s->h_m = rows_.Get(3, "h");
+    s->lon_rad = LongitudeRad(rows_, 2);
+    s->h_m = Height(rows_, 3);
     s->pos_std_ned_m = Sigmas(rows_, 4, "sigma_n", "sigma_e", "sigma_d");
     if (rows_.size() == 13) {
       s->has_velocity = true;
-      s->v_n_mps = Triple(rows_, 7, "v_n", "v_e", "v_d");
+      s->v_n_mps = Velocities(rows_, 7, "v_n", "v_e", "v_d");
       s->vel_std_ned_mps = Sigmas(rows_, 10, "sigma_vn", "sigma_ve", "sigma_vd");
     }
     return true;
@@ -167,12 +208,12 @@ class KfginsNavReader final : public NavReader {
     *s = NavState();
     s->gps_week = ParseWholeNumber(rows_.Text(0), path(), rows_.line(), "week");
     if (s->gps_week < 0) throw InputError(path(), rows_.line(), "week", "negative GPS week");
-    s->t_s = rows_.Get(1, "sow");
+    s->t_s = PlausibleTime(rows_, 1, "sow");
     time_.Check(s->gps_week * kSecondsPerWeek + s->t_s, path(), rows_.line(), "sow");
     s->lat_rad = LatitudeRad(rows_, 2);
-    s->lon_rad = rows_.Get(3, "lon") * kDegToRad;
-    s->h_m = rows_.Get(4, "h");
-    s->v_n_mps = Triple(rows_, 5, "v_n", "v_e", "v_d");
+    s->lon_rad = LongitudeRad(rows_, 3);
+    s->h_m = Height(rows_, 4);
+    s->v_n_mps = Velocities(rows_, 5, "v_n", "v_e", "v_d");
     const Eigen::Vector3d euler_deg = Triple(rows_, 8, "roll", "pitch", "yaw");
     s->q_n_b = QuatFromEuler(euler_deg.x() * kDegToRad, euler_deg.y() * kDegToRad,
                              euler_deg.z() * kDegToRad);
@@ -232,9 +273,10 @@ std::vector<OdometerSample> ReadKfginsImuOdometer(const std::string& path) {
       throw InputError(path, rows.line(), "odo", "an IMU file with 7 columns has no odometer column (OB_GINS: 8)");
     }
     OdometerSample s;
-    s.t_s = rows.Get(0, "t");
+    s.t_s = PlausibleTime(rows, 0, "t");
     time.Check(s.t_s, path, rows.line(), "t");
     s.speed_mps = rows.Get(7, "odo");
+    plausible::Velocity(s.speed_mps, path, rows.line(), "odo");
     out.push_back(s);
   }
   if (out.empty()) rows.ThrowEmpty();

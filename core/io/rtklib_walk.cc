@@ -13,6 +13,7 @@
 
 #include "core/io/csv_imu.h"
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/rate_to_increment.h"
 #include "core/io/rtklib_pos.h"
 #include "core/io/text_reader.h"
@@ -204,6 +205,8 @@ class RawRows {
     for (int k = 0; k < 3; ++k) {
       row->acc_mps2[k] = ParseScaled(fields_[k], kStandardGravity_mps2, path(), line(), kNames[k]);
       row->gyro_radps[k] = ParseScaled(fields_[3 + k], kDegToRad, path(), line(), kNames[3 + k]);
+      plausible::SpecificForce(row->acc_mps2[k], path(), line(), kNames[k]);
+      plausible::AngularRate(row->gyro_radps[k], path(), line(), kNames[3 + k]);
     }
     const long long t = ParseInteger(fields_[6], path(), line(), "t");
     if (t < 0) throw InputError(path(), line(), "t", "negative device time");
@@ -361,6 +364,8 @@ class WalkSfReader final : public ImuReader {
     for (int k = 0; k < 3; ++k) {
       r.acc_mps2[k] = ParseScaled(fields_[1 + k], kStandardGravity_mps2, path(), line(), kNames[k]);
       r.gyro_radps[k] = ParseDouble(fields_[4 + k], path(), line(), kNames[3 + k]);
+      plausible::SpecificForce(r.acc_mps2[k], path(), line(), kNames[k]);
+      plausible::AngularRate(r.gyro_radps[k], path(), line(), kNames[3 + k]);
     }
     return r;
   }

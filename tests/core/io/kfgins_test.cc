@@ -230,6 +230,57 @@ TEST(KfginsTest, SubnormalSigmaIsRefused) {
                    {path, "line 2", "field 'sigma_e'", "subnormal"});
 }
 
+// Finite but absurd values (core/io/plausibility.h): each refused where it is read, naming
+// file, line, field, the value and the limit.
+TEST(KfginsTest, ImplausibleImuValuesAreRefused) {
+  const std::string good = "0.01 1e-4 -0.00113 2e-5 0.001 -0.002 -0.0980665\n";
+  const auto imu = [&](const std::string& name, const std::string& third_line,
+                       std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, "0.00 1e-4 -0.00113 2e-5 0.001 -0.002 -0.0980665\n" + good +
+                                                     third_line + "0.03 0 0 0 0 0 -0.0980665\n");
+    ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(path)); }, parts);
+  };
+  // One deleted byte: -0.00113 -> -1.13e16 ("-1.13e-16" lost its exponent sign).
+  imu("deleted_byte.txt", "0.02 1e-4 -1.13e16 2e-5 0.001 -0.002 -0.0980665\n",
+      {"line 3", "field 'dtheta_y'", "implausible angle increment", "-1.13e+16"});
+  imu("huge_dv.txt", "0.02 1e-4 -0.00113 2e-5 1e300 -0.002 -0.0980665\n",
+      {"line 3", "field 'dv_x'", "implausible velocity increment"});
+  imu("huge_time.txt", "1e16 1e-4 -0.00113 2e-5 0.001 -0.002 -0.0980665\n",
+      {"line 3", "field 't'", "implausible time", "1e+16"});
+  // 1e-4 rad in 0.01 s is 0.57 deg/s; 1.7 rad in 0.01 s (1e4 deg/s) still passes.
+  const std::string fast = WriteTempFile("fast.txt", "0.00 1.7 0 0 0 0 0\n0.01 1.7 0 0 97 0 0\n");
+  EXPECT_EQ(ReadAllSamples(*OpenKfginsImu(fast)).size(), 2u);
+}
+
+TEST(KfginsTest, ImplausibleGnssAndNavValuesAreRefused) {
+  const std::string fix = "100.0 30.0 114.0 20.0 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n";
+  const auto gnss = [&](const std::string& name, const std::string& line2, std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, fix + line2);
+    ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(path)); }, parts);
+  };
+  gnss("height.txt", "101.0 30.0 114.0 1e16 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'h'", "implausible height"});
+  gnss("lon.txt", "101.0 30.0 1e16 20.0 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'lon'", "implausible longitude"});
+  gnss("sigma.txt", "101.0 30.0 114.0 20.0 1e9 0.5 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'sigma_n'", "implausible standard deviation", "1e+09"});
+  gnss("tiny_sigma.txt", "101.0 30.0 114.0 20.0 0.5 1e-15 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'sigma_e'", "implausible standard deviation"});
+  gnss("velocity.txt", "101.0 30.0 114.0 20.0 0.5 0.5 1.0 1 -1e16 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'v_e'", "implausible velocity"});
+  gnss("vsigma.txt", "101.0 30.0 114.0 20.0 0.5 0.5 1.0 1 2 3 0.1 1e300 0.1\n",
+       {"line 2", "field 'sigma_ve'", "implausible standard deviation"});
+  gnss("time.txt", "1e16 30.0 114.0 20.0 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n", {"line 2", "field 't'", "implausible time"});
+  const std::string nav_line = "2381 100.0 30.0 114.0 20.0 1 2 3 0 0 90\n";
+  const auto nav = [&](const std::string& name, const std::string& line2, std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, nav_line + line2);
+    ExpectInputError([&] { ReadAllSamples(*OpenKfginsNav(path)); }, parts);
+  };
+  nav("nav_h.nav", "2381 101.0 30.0 114.0 -1e16 1 2 3 0 0 90\n", {"line 2", "field 'h'", "implausible height"});
+  nav("nav_v.nav", "2381 101.0 30.0 114.0 20.0 1 2 3e16 0 0 90\n", {"line 2", "field 'v_d'", "implausible velocity"});
+  nav("nav_t.nav", "2381 1e16 30.0 114.0 20.0 1 2 3 0 0 90\n", {"line 2", "field 'sow'", "implausible time"});
+}
+
 TEST(KfginsTest, UncommittedWriterLeavesNoFile) {
   const std::string path = TempFilePath("uncommitted.txt");
   std::remove(path.c_str());
