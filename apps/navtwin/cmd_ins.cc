@@ -3,8 +3,6 @@
 // built-in flight into OUT first and navigates it against its own truth.
 #include <gflags/gflags.h>
 
-#include <sys/stat.h>
-
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -13,12 +11,14 @@
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
 #include "core/calibration_file.h"
+#include "core/io/folder.h"
 #include "core/io/input_error.h"
 #include "core/io/json_writer.h"
 #include "core/io/kfgins.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
 #include "problems/ins/demo_flight.h"
+#include "problems/ins/imu_gaps.h"
 #include "problems/ins/pure_ins.h"
 
 DEFINE_double(init_lat_deg, NAN, "Initial latitude, deg");
@@ -31,17 +31,14 @@ DEFINE_double(init_roll_deg, 0.0, "Initial roll, deg");
 DEFINE_double(init_pitch_deg, 0.0, "Initial pitch, deg");
 DEFINE_double(init_yaw_deg, NAN, "Initial yaw (heading), deg");
 DEFINE_double(hold_height_m, NAN, "Hold the height at this value (damps the unstable vertical channel)");
+DEFINE_double(max_bridge_gap_s, 0.1,
+              "IMU gaps (intervals over 1.5 nominal) up to this are bridged by spreading the next sample's "
+              "increments, longer ones stop the run, s");
 DEFINE_double(demo_rate_hz, 100.0, "IMU rate of the demo flight, Hz");
 DEFINE_double(demo_duration_s, 600.0, "Length of the demo flight, s");
 
 namespace navtwin::app {
 namespace {
-
-bool MakeDir(const std::string& dir) {
-  if (::mkdir(dir.c_str(), 0755) == 0) return true;
-  struct stat st;
-  return ::stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
 
 std::optional<double> Optional(double x) { return std::isnan(x) ? std::nullopt : std::optional<double>(x); }
 
@@ -148,7 +145,9 @@ int RunIns(const std::vector<std::string>& args) {
   if (FLAGS_calibration.empty() && !std::isnan(FLAGS_imu_temperature_degC)) {
     return Usage("--imu_temperature_degC goes with --calibration");
   }
-  if (!MakeDir(FLAGS_out)) return Usage("cannot create the output folder " + FLAGS_out);
+  if (!(FLAGS_max_bridge_gap_s >= 0.0)) return Usage("--max_bridge_gap_s must be >= 0");
+  OutputFolder folder(FLAGS_out);
+  if (!folder.Make()) return Usage("cannot create the output folder " + FLAGS_out);
 
   std::string imu_path = FLAGS_imu, truth_path = FLAGS_truth, init_path = FLAGS_init_from;
   if (FLAGS_demo) {
@@ -157,6 +156,7 @@ int RunIns(const std::vector<std::string>& args) {
     const DemoFiles demo = WriteDemoFlight(FLAGS_out, FLAGS_demo_rate_hz, FLAGS_demo_duration_s);
     imu_path = demo.imu_path;
     truth_path = init_path = demo.truth_path;
+    folder.Keep();  // the simulated files stay
   }
 
   NavState initial;
@@ -166,6 +166,8 @@ int RunIns(const std::vector<std::string>& args) {
   } else {
     initial = StateFromFlags(std::isnan(FLAGS_start_s) ? FirstImuEpoch(imu_path) : FLAGS_start_s);
   }
+  RequireMechanizable(initial, init_path.empty() ? std::string("--init_lat_deg/--init_lon_deg/--init_h_m") : init_path,
+                      "initial state");
 
   PureInsOptions options;
   options.strapdown.hold_height_m = Optional(FLAGS_hold_height_m);
@@ -173,7 +175,8 @@ int RunIns(const std::vector<std::string>& args) {
   options.end_time_s = FLAGS_end_s;
   options.progress_every = 200000;
 
-  auto imu = OpenImu(imu_path, FLAGS_calibration, FLAGS_imu_temperature_degC);
+  auto imu = ins::GapBridgingImuReader(OpenImu(imu_path, FLAGS_calibration, FLAGS_imu_temperature_degC),
+                                       FLAGS_max_bridge_gap_s, "--max_bridge_gap_s");
   std::unique_ptr<NavReader> truth;
   if (!truth_path.empty()) truth = OpenNav(truth_path);
   const std::string nav_path = FLAGS_out + "/nav.nav";
@@ -181,6 +184,7 @@ int RunIns(const std::vector<std::string>& args) {
   const PureInsResult result = RunPureIns(
       *imu, initial, options, [&](const NavState& s) { writer.Write(s); }, truth.get());
   writer.Commit();
+  folder.Keep();
   if (truth && !result.errors) {
     std::cerr << "ins: warning: the truth file " << truth_path << " has no epoch inside the run\n";
   }
@@ -199,10 +203,10 @@ Command InsCommand() {
           "Pure inertial navigation (strapdown) over an IMU record; errors against a truth file",
           "navtwin ins --imu F (--init_from NAVFILE | --init_lat_deg D --init_lon_deg D "
           "--init_yaw_deg D [--init_h_m ...]) --out DIR [--truth F] [--output_rate_hz R] "
-          "[--calibration FILE [--imu_temperature_degC T]] [--format=json]\n       navtwin ins --demo --out DIR",
+          "[--max_bridge_gap_s S] [--calibration FILE [--imu_temperature_degC T]] [--format=json]\n       navtwin ins --demo --out DIR",
           {"imu", "out", "truth", "init_from", "init_lat_deg", "init_lon_deg", "init_h_m",
            "init_vn_mps", "init_ve_mps", "init_vd_mps", "init_roll_deg", "init_pitch_deg",
-           "init_yaw_deg", "start_s", "end_s", "output_rate_hz", "hold_height_m", "demo",
+           "init_yaw_deg", "start_s", "end_s", "output_rate_hz", "hold_height_m", "max_bridge_gap_s", "demo",
            "demo_rate_hz", "demo_duration_s", "calibration", "imu_temperature_degC"},
           &RunIns};
 }

@@ -23,6 +23,7 @@
 
 #include "apps/navtwin/command.h"
 #include "apps/navtwin/common_flags.h"
+#include "core/io/folder.h"
 #include "core/io/json_writer.h"
 #include "core/io/open.h"
 #include "core/io/ulog_time.h"
@@ -57,32 +58,6 @@ int Usage(const std::string& command, const std::string& why, const std::string&
   std::cerr << "navtwin " << command << ": " << why << "\nusage: " << usage << "\n";
   return kExitUsage;
 }
-
-bool IsDir(const std::string& dir) {
-  struct stat st;
-  return ::stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-/// The output folder: created when missing, and removed again (if still empty) when the
-/// run fails, so that a failed run leaves nothing behind.
-class OutputFolder {
- public:
-  explicit OutputFolder(std::string dir) : dir_(std::move(dir)) {}
-  ~OutputFolder() {
-    if (created_ && !keep_) ::rmdir(dir_.c_str());
-  }
-  bool Make() {
-    if (IsDir(dir_)) return true;
-    created_ = ::mkdir(dir_.c_str(), 0755) == 0;
-    return created_;
-  }
-  void Keep() { keep_ = true; }
-
- private:
-  std::string dir_;
-  bool created_ = false;
-  bool keep_ = false;
-};
 
 std::string Num(double x) {
   std::ostringstream s;

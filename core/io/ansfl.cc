@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/rate_to_increment.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
@@ -263,6 +264,7 @@ class DotImuReader final : public ImuReader {
       rate.t_s = r.t_s;
       rate.gyro_radps = r.gyro_dps * kDegToRad;
       rate.acc_mps2 = r.acc_mps2;
+      CheckRates(rate, r.line);
       if (to_increment_.Add(rate, sample)) return true;
     }
     if (used_ == 0) throw InputError(path(), 0, "", "no samples (only a header)");
@@ -272,6 +274,16 @@ class DotImuReader final : public ImuReader {
     return false;
   }
   const std::string& path() const override { return rows_.path(); }
+
+  /// Rates within the full scales of core/io/plausibility.h.
+  void CheckRates(const RateSample& rate, long line) const {
+    const char* acc[3] = {"Acc_X", "Acc_Y", "Acc_Z"};
+    const char* gyro[3] = {"Gyr_X", "Gyr_Y", "Gyr_Z"};
+    for (int k = 0; k < 3; ++k) {
+      plausible::SpecificForce(rate.acc_mps2[k], path(), line, acc[k]);
+      plausible::AngularRate(rate.gyro_radps[k], path(), line, gyro[k]);
+    }
+  }
 
   std::size_t zero_skipped() const { return zero_skipped_; }
   std::size_t lost_dropped() const { return lost_dropped_; }
@@ -299,6 +311,8 @@ class DotMagReader final : public MagReader {
     if (!rows_.Next(&r)) return false;
     sample->t_s = r.t_s;
     sample->m_b_uT = r.mag_au * kXsensDotMagUtPerUnit;
+    const char* names[3] = {"Mag_X", "Mag_Y", "Mag_Z"};
+    for (int k = 0; k < 3; ++k) plausible::MagneticField(sample->m_b_uT[k], path(), r.line, names[k]);
     return true;
   }
   const std::string& path() const override { return rows_.path(); }
@@ -355,8 +369,12 @@ class GtExtRows {
     }
     r->position.lat_rad = lat_deg * kDegToRad;
     r->position.lon_rad = csv_.Get(lon_) * kDegToRad;
+    plausible::Longitude(r->position.lon_rad, path(), r->line, "longitude");
     r->position.h_m = csv_.Get(alt_);
+    plausible::Height(r->position.h_m, path(), r->line, "altitude_above_seaLevel");
     r->v_n_mps = csv_.Get3(speed_[0], speed_[1], speed_[2]);
+    const char* speeds[3] = {"xSpeed", "ySpeed", "zSpeed"};
+    for (int k = 0; k < 3; ++k) plausible::Velocity(r->v_n_mps[k], path(), r->line, speeds[k]);
     r->rpy_deg = csv_.Get3(rpy_[0], rpy_[1], rpy_[2]);
     return true;
   }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/rate_to_increment.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
@@ -24,12 +25,14 @@ class CsvImuReader final : public ImuReader {
         r.t_s = time_s_;
         r.gyro_radps = Triple(0);
         r.acc_mps2 = Triple(3);
+        CheckRates(r);
         if (to_increment_.Add(r, sample)) return true;
       } else {
         ImuSample row;
         row.t_s = time_s_;
         row.dtheta_b_rad = Triple(0);
         row.dv_b_mps = Triple(3);
+        CheckIncrements(row);
         if (intervals_.Add(row, sample)) return true;
       }
     }
@@ -79,6 +82,8 @@ class CsvImuReader final : public ImuReader {
       SplitCsv(line_, &fields_);
       RequireFieldCount(fields_.size(), header_.size(), path(), lines_.line_number());
       time_s_ = Value(time_);
+      plausible::Time(time_s_, path(), lines_.line_number(), time_.name);
+      dt_s_ = monotonic_.has_previous() ? time_s_ - monotonic_.previous_s() : plausible::kFirstIncrementInterval_s;
       monotonic_.Check(time_s_, path(), lines_.line_number(), time_.name);
       ++rows_;
       return true;
@@ -87,10 +92,22 @@ class CsvImuReader final : public ImuReader {
   }
 
   double Value(const UnitColumn& c) const {
-    return ParseDouble(fields_[static_cast<std::size_t>(c.index)], path(), lines_.line_number(),
-                       c.name) *
-           c.scale;
+    return ParseScaled(fields_[static_cast<std::size_t>(c.index)], c.scale, path(), lines_.line_number(), c.name);
   }
+  /// Rates and increments within the full scales of core/io/plausibility.h.
+  void CheckRates(const RateSample& r) const {
+    for (int k = 0; k < 3; ++k) {
+      plausible::AngularRate(r.gyro_radps[k], path(), lines_.line_number(), columns_[k].name);
+      plausible::SpecificForce(r.acc_mps2[k], path(), lines_.line_number(), columns_[3 + k].name);
+    }
+  }
+  void CheckIncrements(const ImuSample& row) const {
+    for (int k = 0; k < 3; ++k) {
+      plausible::AngleIncrement(row.dtheta_b_rad[k], dt_s_, path(), lines_.line_number(), columns_[k].name);
+      plausible::VelocityIncrement(row.dv_b_mps[k], dt_s_, path(), lines_.line_number(), columns_[3 + k].name);
+    }
+  }
+
   Eigen::Vector3d Triple(int first) const {
     return Eigen::Vector3d(Value(columns_[first]), Value(columns_[first + 1]),
                            Value(columns_[first + 2]));
@@ -104,6 +121,7 @@ class CsvImuReader final : public ImuReader {
   std::string line_;
   std::vector<std::string_view> fields_;
   double time_s_ = 0.0;
+  double dt_s_ = 0.0;  ///< since the previous row (plausible::kFirstIncrementInterval_s for the first)
   std::size_t rows_ = 0;
   IncreasingTime monotonic_;
   RateToIncrement to_increment_;

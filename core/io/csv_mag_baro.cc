@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/text_reader.h"
 #include "core/units.h"
 
@@ -38,6 +39,7 @@ class CsvTable {
       SplitCsv(line_, &fields_);
       RequireFieldCount(fields_.size(), header_.size(), path(), line());
       time_s_ = Value(time_);
+      plausible::Time(time_s_, path(), line(), time_.name);
       monotonic_.Check(time_s_, path(), line(), time_.name);
       ++rows_;
       return true;
@@ -48,7 +50,7 @@ class CsvTable {
 
   /// The number in column c times its unit factor.
   double Value(const UnitColumn& c) const {
-    return ParseDouble(Field(c), path(), line(), c.name) * c.scale;
+    return ParseScaled(Field(c), c.scale, path(), line(), c.name);
   }
   /// Like Value, but NaN for an absent column or an empty field.
   double OptionalValue(const UnitColumn& c) const {
@@ -91,7 +93,10 @@ class CsvMagReader final : public MagReader {
   bool Next(MagSample* sample) override {
     if (!table_.NextRow()) return false;
     sample->t_s = table_.time_s();
-    for (int k = 0; k < 3; ++k) sample->m_b_uT[k] = table_.Value(axes_[k]);
+    for (int k = 0; k < 3; ++k) {
+      sample->m_b_uT[k] = table_.Value(axes_[k]);
+      plausible::MagneticField(sample->m_b_uT[k], path(), table_.line(), axes_[k].name);
+    }
     return true;
   }
   const std::string& path() const override { return table_.path(); }
@@ -121,7 +126,9 @@ class CsvBaroReader final : public BaroReader {
     sample->temperature_degC = table_.OptionalValue(temperature_);
     if (!std::isnan(sample->pressure_pa)) {
       RequirePositive(sample->pressure_pa, path(), table_.line(), pressure_.name);
+      plausible::Pressure(sample->pressure_pa, path(), table_.line(), pressure_.name);
     }
+    if (!std::isnan(sample->altitude_m)) plausible::Height(sample->altitude_m, path(), table_.line(), altitude_.name);
     if (sample->temperature_degC <= kAbsoluteZero_degC) {
       throw InputError(path(), table_.line(), temperature_.name, "below absolute zero");
     }

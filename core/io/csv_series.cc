@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 
 namespace navtwin {
 namespace {
@@ -58,12 +59,12 @@ ScalarSeries ReadScalarSeriesCsv(const std::string& path, std::initializer_list<
     }
     SplitCsv(line, &fields);
     RequireFieldCount(fields.size(), header.size(), path, lines.line_number());
-    const double t = ParseDouble(fields[static_cast<std::size_t>(time.index)], path, lines.line_number(), time.name) *
-                     time.scale;
+    const double t =
+        ParseScaled(fields[static_cast<std::size_t>(time.index)], time.scale, path, lines.line_number(), time.name);
+    plausible::Time(t, path, lines.line_number(), time.name);
     monotonic.Check(t, path, lines.line_number(), time.name);
-    const double v = ParseDouble(fields[static_cast<std::size_t>(column.index)], path, lines.line_number(),
-                                 column.name) *
-                     column.scale;
+    const double v = ParseScaled(fields[static_cast<std::size_t>(column.index)], column.scale, path,
+                                 lines.line_number(), column.name);
     if (v < lo || v > hi) {
       std::ostringstream why;
       why.precision(10);

@@ -63,8 +63,9 @@ class KfginsGnssWriter {
 
 /// The navigation record's fields after the week, "t lat lon h vn ve vd roll pitch yaw" (s,
 /// deg, m, m/s, deg; attitude the ZYX Euler angles of q_n_b), each in the shortest form
-/// that reads back exactly, separated by `separator`. Throws std::invalid_argument for a
-/// non-finite state.
+/// that reads back exactly, separated by `separator`; the longitude wrapped into
+/// (-180, 180]. Throws std::invalid_argument for a non-finite or impossible state: |lat| >
+/// 90 deg, a height or a velocity outside the limits of core/io/plausibility.h.
 void AppendNavFields(const NavState& s, char separator, TextLine* line);
 
 /// Writes the navigation format; gps_week = -1 (unknown) is written as week 0. Attitude

@@ -7,6 +7,7 @@
 
 #include "core/gps_time.h"
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/text_reader.h"
 #include "core/rotation.h"
 #include "core/text.h"
@@ -126,7 +127,9 @@ class RtklibPosReader final : public GnssReader {
     }
     s->lat_rad = lat_deg * kDegToRad;
     s->lon_rad = Get(col_.lon, "longitude") * kDegToRad;
+    plausible::Longitude(s->lon_rad, path(), line, "longitude");
     s->h_m = Get(col_.h, "height");
+    plausible::Height(s->h_m, path(), line, "height");
     s->quality = ParseWholeNumber(fields_[2 + col_.q], path(), line, "Q");
     s->num_sats = ParseWholeNumber(fields_[2 + col_.ns], path(), line, "ns");
     if (s->quality < 0 || s->num_sats < 0) {
@@ -137,6 +140,8 @@ class RtklibPosReader final : public GnssReader {
       s->has_velocity = true;
       s->v_n_mps =
           Eigen::Vector3d(Get(col_.vn, "vn"), Get(col_.vn + 1, "ve"), -Get(col_.vn + 2, "vu"));
+      const char* names[3] = {"vn", "ve", "vu"};
+      for (int k = 0; k < 3; ++k) plausible::Velocity(s->v_n_mps[k], path(), line, names[k]);
       s->vel_std_ned_mps = Sigmas(col_.sdvn, {"sdvn", "sdve", "sdvu"});
     }
     return true;
@@ -238,6 +243,7 @@ class RtklibPosReader final : public GnssReader {
     for (const char* n : names) {
       s[k] = Get(first + k, n);
       RequirePositive(s[k], path(), lines_.line_number(), n);
+      plausible::Sigma(s[k], path(), lines_.line_number(), n);
       ++k;
     }
     return s;

@@ -13,6 +13,7 @@
 
 #include "core/io/csv_imu.h"
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/rate_to_increment.h"
 #include "core/io/rtklib_pos.h"
 #include "core/io/text_reader.h"
@@ -159,8 +160,8 @@ class TagFile {
 
 /// One complete line of the raw file.
 struct RawRow {
-  double acc_g[3] = {0, 0, 0};
-  double gyro_dps[3] = {0, 0, 0};
+  double acc_mps2[3] = {0, 0, 0};   ///< read in g
+  double gyro_radps[3] = {0, 0, 0};  ///< read in deg/s
   double device_ms = 0.0;
   std::uint64_t end_offset = 0;  ///< just past its line break
   std::uint64_t lf_breaks = 0;   ///< bare-LF line breaks up to and including this line's
@@ -202,8 +203,10 @@ class RawRows {
   void Parse(RawRow* row) {
     static const char* kNames[6] = {"ax", "ay", "az", "gx", "gy", "gz"};
     for (int k = 0; k < 3; ++k) {
-      row->acc_g[k] = ParseDouble(fields_[k], path(), line(), kNames[k]);
-      row->gyro_dps[k] = ParseDouble(fields_[3 + k], path(), line(), kNames[3 + k]);
+      row->acc_mps2[k] = ParseScaled(fields_[k], kStandardGravity_mps2, path(), line(), kNames[k]);
+      row->gyro_radps[k] = ParseScaled(fields_[3 + k], kDegToRad, path(), line(), kNames[3 + k]);
+      plausible::SpecificForce(row->acc_mps2[k], path(), line(), kNames[k]);
+      plausible::AngularRate(row->gyro_radps[k], path(), line(), kNames[3 + k]);
     }
     const long long t = ParseInteger(fields_[6], path(), line(), "t");
     if (t < 0) throw InputError(path(), line(), "t", "negative device time");
@@ -303,8 +306,8 @@ class WalkImuReader final : public ImuReader {
       RateSample rate;
       rate.t_s = clock_.GpsSow(r.device_ms);
       for (int k = 0; k < 3; ++k) {
-        rate.acc_mps2[k] = r.acc_g[k] * kStandardGravity_mps2;
-        rate.gyro_radps[k] = r.gyro_dps[k] * kDegToRad;
+        rate.acc_mps2[k] = r.acc_mps2[k];
+        rate.gyro_radps[k] = r.gyro_radps[k];
       }
       if (to_increment_.Add(rate, sample)) return true;
     }
@@ -359,9 +362,10 @@ class WalkSfReader final : public ImuReader {
     time_.Check(r.t_s, path(), line(), "time");
     static const char* kNames[6] = {"ax", "ay", "az", "gx", "gy", "gz"};
     for (int k = 0; k < 3; ++k) {
-      r.acc_mps2[k] =
-          ParseDouble(fields_[1 + k], path(), line(), kNames[k]) * kStandardGravity_mps2;
+      r.acc_mps2[k] = ParseScaled(fields_[1 + k], kStandardGravity_mps2, path(), line(), kNames[k]);
       r.gyro_radps[k] = ParseDouble(fields_[4 + k], path(), line(), kNames[3 + k]);
+      plausible::SpecificForce(r.acc_mps2[k], path(), line(), kNames[k]);
+      plausible::AngularRate(r.gyro_radps[k], path(), line(), kNames[3 + k]);
     }
     return r;
   }

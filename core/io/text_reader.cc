@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "core/io/input_error.h"
@@ -152,6 +153,18 @@ double ParseDouble(std::string_view text, const std::string& path, long line,
   return value;
 }
 
+double ParseScaled(std::string_view text, double scale, const std::string& path, long line,
+                   const std::string& field) {
+  const double value = ParseDouble(text, path, line, field) * scale;
+  if (!std::isfinite(value)) {
+    std::ostringstream os;
+    os << "not a finite number in SI units: " << Quote(text) << " times the unit factor " << scale
+       << " overflows";
+    throw InputError(path, line, field, os.str());
+  }
+  return value;
+}
+
 long long ParseInteger(std::string_view text, const std::string& path, long line,
                        const std::string& field) {
   std::string_view t = text;
@@ -178,6 +191,13 @@ void RequirePositive(double value, const std::string& path, long line, const std
   if (!(value > 0.0)) {
     std::ostringstream os;
     os << "must be > 0, got " << value;
+    throw InputError(path, line, field, os.str());
+  }
+  // A subnormal value (below 2.2e-308) is > 0 but has lost its precision, and 1/value^2
+  // (a weight) overflows.
+  if (value < std::numeric_limits<double>::min()) {
+    std::ostringstream os;
+    os << "must be > 0 and not subnormal (below " << std::numeric_limits<double>::min() << "), got " << value;
     throw InputError(path, line, field, os.str());
   }
 }

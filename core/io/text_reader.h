@@ -67,13 +67,17 @@ void SplitLoose(std::string_view line, std::vector<std::string_view>* fields);
 /// line and field when it is not a number or not finite (nan, inf).
 double ParseDouble(std::string_view text, const std::string& path, long line,
                    const std::string& field);
+/// ParseDouble times `scale` (a unit's factor to SI); throws InputError naming file, line and
+/// field also when the product is not finite (1e308 g is finite, in m/s^2 it is not).
+double ParseScaled(std::string_view text, double scale, const std::string& path, long line,
+                   const std::string& field);
 /// Whole-field decimal integer; throws InputError like ParseDouble.
 long long ParseInteger(std::string_view text, const std::string& path, long line,
                        const std::string& field);
 /// A number that must be a whole number (RTKLIB writes Q and ns as "1.0000000").
 int ParseWholeNumber(std::string_view text, const std::string& path, long line,
                      const std::string& field);
-/// Throws InputError unless value > 0 (standard deviations, intervals).
+/// Throws InputError unless value > 0 and not subnormal (standard deviations, intervals).
 void RequirePositive(double value, const std::string& path, long line, const std::string& field);
 /// Throws InputError unless the line has exactly `expected` fields.
 void RequireFieldCount(std::size_t found, std::size_t expected, const std::string& path, long line);

@@ -8,6 +8,7 @@
 
 #include "core/gps_time.h"
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
 #include "core/io/ulog.h"
 #include "core/io/ulog_time.h"
 #include "core/io/ulog_topic.h"
@@ -25,6 +26,27 @@ constexpr double kMinFixType = 3;  // PX4 fix_type: 0-1 none, 2 2D, 3 3D, 4+ DGP
 // aircraft meets is above 2000 Pa (about 26 km) and below 2000 hPa, so the two do not mix.
 constexpr double kBaroPascalFloor_pa = 2000.0;
 constexpr double kHectopascal_pa = 100.0;
+
+/// A plausibility check of core/io/plausibility.h (which names a line) turned into the
+/// ULog error that names the record's byte offset and field.
+template <typename Check>
+void Plausible(const TimeOrderedTopic& topic, const std::string& field, Check check) {
+  try {
+    check(topic.log().path(), 0L, field);
+  } catch (const InputError& e) {
+    throw topic.ErrorAt(field, e.reason());
+  }
+}
+
+/// Each component of a vector field within the limits of `check`.
+template <typename Check>
+void PlausibleVector(const TimeOrderedTopic& topic, const std::string& field, const Eigen::Vector3d& v, Check check) {
+  for (int k = 0; k < 3; ++k) {
+    Plausible(topic, field, [&](const std::string& path, long line, const std::string& name) {
+      check(v[k], path, line, name);
+    });
+  }
+}
 
 class ULogImuReader final : public ImuReader {
  public:
@@ -46,9 +68,12 @@ class ULogImuReader final : public ImuReader {
       sample->t_s = topic_.t_s();
       sample->dt_s = dt_s;
       // The rates are averages over the integration time; without one, over dt_s.
-      sample->dtheta_b_rad = topic_.Vector("gyro_rad") * (gyro_dt_s > 0.0 ? gyro_dt_s : dt_s);
-      sample->dv_b_mps =
-          topic_.Vector("accelerometer_m_s2") * (accel_dt_s > 0.0 ? accel_dt_s : dt_s);
+      const Eigen::Vector3d gyro_radps = topic_.Vector("gyro_rad");
+      const Eigen::Vector3d acc_mps2 = topic_.Vector("accelerometer_m_s2");
+      PlausibleVector(topic_, "gyro_rad", gyro_radps, plausible::AngularRate);
+      PlausibleVector(topic_, "accelerometer_m_s2", acc_mps2, plausible::SpecificForce);
+      sample->dtheta_b_rad = gyro_radps * (gyro_dt_s > 0.0 ? gyro_dt_s : dt_s);
+      sample->dv_b_mps = acc_mps2 * (accel_dt_s > 0.0 ? accel_dt_s : dt_s);
       return true;
     }
     return false;
@@ -124,6 +149,9 @@ class ULogGnssReader final : public GnssReader {
     s->lat_rad = lat_deg * kDegToRad;
     s->lon_rad = lon_deg * kDegToRad;
     s->h_m = topic_.Finite(f.height) * f.m_per_unit;
+    Plausible(topic_, f.height, [&](const std::string& path, long line, const std::string& name) {
+      plausible::Height(s->h_m, path, line, name);
+    });
     const double eph = topic_.Sigma("eph");
     s->pos_std_ned_m = {eph, eph, topic_.Sigma("epv")};
   }
@@ -134,6 +162,7 @@ class ULogGnssReader final : public GnssReader {
     if (s->has_velocity) {
       s->v_n_mps = {topic_.Finite("vel_n_m_s"), topic_.Finite("vel_e_m_s"),
                     topic_.Finite("vel_d_m_s")};
+      PlausibleVector(topic_, "vel_n_m_s", s->v_n_mps, plausible::Velocity);
       s->vel_std_ned_mps = Eigen::Vector3d::Constant(topic_.Sigma("s_variance_m_s"));
     } else {
       s->v_n_mps.setZero();
@@ -167,6 +196,12 @@ class ULogMagReader final : public MagReader {
             : topic_.Vector("magnetometer_ga");
     s->t_s = topic_.t_s();
     s->m_b_uT = kGauss_uT * gauss;
+    const char* axes[3] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) {
+      Plausible(topic_, xyz ? axes[k] : "magnetometer_ga", [&](const std::string& p, long line, const std::string& name) {
+        plausible::MagneticField(s->m_b_uT[k], p, line, name);
+      });
+    }
     return true;
   }
   const std::string& path() const override { return path_; }

@@ -13,14 +13,11 @@
 #include "core/io/input_error.h"
 #include "core/io/open.h"
 #include "core/rotation.h"
+#include "problems/ins/imu_gaps.h"
 #include "problems/ins/ins_state.h"
 
 namespace navtwin::gnss_ins {
 namespace {
-
-/// Tolerance on time comparisons at the cut points (time tags are often printed with
-/// An interval longer than this many nominal intervals is a gap.
-constexpr double kGapFactor = 1.5;
 
 std::string Num(double x) {
   std::ostringstream s;
@@ -31,15 +28,6 @@ std::string Num(double x) {
 
 void RequireFinite(bool ok, const std::string& file, const std::string& field, double t_s) {
   if (!ok) throw InputError(file, 0, field, "not a finite number (sample at t = " + Num(t_s) + " s)");
-}
-
-/// Median of the sample intervals (the nominal interval; robust to gaps and jitter).
-double MedianInterval(const std::vector<ImuSample>& imu) {
-  std::vector<double> dt;
-  dt.reserve(imu.size());
-  for (const ImuSample& s : imu) dt.push_back(s.dt_s);
-  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
-  return dt[dt.size() / 2];
 }
 
 /// Barometric altitude from pressure in the ISA troposphere (ISO 2533):
@@ -112,43 +100,6 @@ std::vector<ImuSample> ReadImu(const std::string& path, const RunCalibration& ca
     throw InputError(path, 0, "time",
                      "fewer than 2 IMU samples inside the configured span [" +
                          Num(config.start_time_s) + ", " + Num(config.end_time_s) + "] s");
-  }
-  return out;
-}
-
-/// Bridges gaps (an interval > 1.5 nominal and <= max_gap_s) by spreading the increments
-/// of the sample after the gap evenly over round(dt / nominal) intervals: the time tags say
-/// the increments cover the whole gap (an IMU that accumulates while its output is dropped);
-/// for an IMU that lost the samples instead, the lost increments are an error that short
-/// gaps keep small. Longer gaps: InputError naming the file and the time.
-std::vector<ImuSample> BridgeGaps(const std::vector<ImuSample>& imu, const std::string& path,
-                                  double time_offset_s, double max_gap_s, std::size_t* bridged) {
-  const double nominal = MedianInterval(imu);
-  std::vector<ImuSample> out;
-  out.reserve(imu.size());
-  for (const ImuSample& s : imu) {
-    if (s.dt_s <= kGapFactor * nominal) {
-      out.push_back(s);
-      continue;
-    }
-    const double t0 = s.t_s - s.dt_s;
-    if (s.dt_s > max_gap_s) {
-      throw InputError(path, 0, "time",
-                       "IMU gap of " + Num(s.dt_s) + " s between t = " + Num(t0 - time_offset_s) +
-                           " s and t = " + Num(s.t_s - time_offset_s) +
-                           " s (file time), longer than filter.max_bridge_gap_s = " +
-                           Num(max_gap_s) + " s (nominal interval " + Num(nominal) + " s)");
-    }
-    const int n = std::max(2, static_cast<int>(std::lround(s.dt_s / nominal)));
-    for (int k = 1; k <= n; ++k) {
-      ImuSample piece = s;
-      piece.t_s = k == n ? s.t_s : t0 + s.dt_s * k / n;
-      piece.dt_s = piece.t_s - (t0 + s.dt_s * (k - 1) / n);
-      piece.dtheta_b_rad = s.dtheta_b_rad / n;
-      piece.dv_b_mps = s.dv_b_mps / n;
-      out.push_back(piece);
-    }
-    ++*bridged;
   }
   return out;
 }
@@ -251,8 +202,9 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
   in.paths = paths;
   in.installation = calibration.installation;
   in.installation_from_calibration = calibration.installation_from_file;
-  in.imu = BridgeGaps(ReadImu(paths.imu, calibration, paths.imu_temperature_degC, config), paths.imu,
-                      calibration.installation.imu_time_offset_s, config.filter.max_bridge_gap_s, &in.bridged_imu_gaps);
+  in.imu = ins::BridgeGaps(ReadImu(paths.imu, calibration, paths.imu_temperature_degC, config), paths.imu,
+                           calibration.installation.imu_time_offset_s, config.filter.max_bridge_gap_s,
+                           "filter.max_bridge_gap_s", &in.bridged_imu_gaps);
   const double t_begin = in.imu.front().t_s - in.imu.front().dt_s;
   const double t_end = in.imu.back().t_s;
 

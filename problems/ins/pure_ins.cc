@@ -3,8 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <sstream>
+#include <string>
 
 #include "core/io/input_error.h"
+#include "core/io/plausibility.h"
+#include "core/units.h"
 #include "problems/ins/ins_state.h"
 
 namespace navtwin {
@@ -35,6 +39,33 @@ class TruthComparer {
 };
 
 }  // namespace
+
+void RequireMechanizable(const NavState& s, const std::string& source, const std::string& what) {
+  const auto refuse = [&](const std::string& field, const auto&... why) {
+    std::ostringstream os;
+    os.precision(12);
+    os << what << " at t = " << s.t_s << " s: ";
+    (os << ... << why);
+    throw InputError(source, 0, field, os.str());
+  };
+  if (!std::isfinite(s.lat_rad) || !std::isfinite(s.lon_rad) || !std::isfinite(s.h_m) || !s.v_n_mps.allFinite() ||
+      !s.q_n_b.coeffs().allFinite()) {
+    refuse("state", "not a finite number");
+  }
+  const double lat_deg = s.lat_rad * kRadToDeg;
+  if (std::abs(lat_deg) >= 90.0 - kPolarMargin_deg) {
+    refuse("lat", "latitude ", lat_deg, " deg is within ", kPolarMargin_deg,
+           " deg of a pole, where the NED mechanization is singular");
+  }
+  if (s.h_m < plausible::kMinHeight_m || s.h_m > plausible::kMaxHeight_m) {
+    refuse("h", "height ", s.h_m, " m outside the plausible band [", plausible::kMinHeight_m, ", ",
+           plausible::kMaxHeight_m, "] m");
+  }
+  const double v_max = s.v_n_mps.cwiseAbs().maxCoeff();
+  if (v_max > plausible::kMaxSpeed_mps) {
+    refuse("v_n", "a velocity component of ", v_max, " m/s, above the plausible ", plausible::kMaxSpeed_mps, " m/s");
+  }
+}
 
 NavState InitialStateFromNav(NavReader& nav, std::optional<double> start_s) {
   NavState s;
@@ -68,6 +99,7 @@ PureInsResult RunPureIns(ImuReader& imu, const NavState& initial, const PureInsO
     if (s.t_s > options.end_time_s + kEpochTolerance_s) break;
     const NavState prev = ins.state();
     ins.Update(s);
+    RequireMechanizable(ins.state(), imu.path(), "the solution (pure inertial navigation)");
     ++result.imu_samples;
     if (truth) comparer.Advance(prev, ins.state(), &stats);
     if (output && ins.state().t_s >= next_output_s - kEpochTolerance_s) {

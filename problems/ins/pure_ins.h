@@ -5,12 +5,27 @@
 
 #include <functional>
 #include <optional>
+#include <string>
 
 #include "core/io/sample_reader.h"
 #include "core/strapdown.h"
 #include "problems/ins/nav_error.h"
 
 namespace navtwin {
+
+/// The NED mechanization is singular at the poles: the longitude rate v_E / ((R_N + h) cos
+/// lat) and the transport rate's tan(lat) term grow without bound (at lat = 90 deg cos lat
+/// is 6e-17 and one step swings the velocity by 1e9 m/s). Within 0.01 deg of a pole (1.1
+/// km) the first-order position and transport-rate integration is no longer valid at
+/// vehicle speeds and IMU rates (300 m/s at 100 Hz turns the longitude by 0.15 deg per
+/// step there); closer starts and solutions are refused.
+constexpr double kPolarMargin_deg = 0.01;
+
+/// Throws InputError(source, 0, field, ...) naming the time and what is impossible when the
+/// state cannot be mechanized: not finite, |lat| >= 90 deg - kPolarMargin_deg, a height or
+/// velocity outside the limits of core/io/plausibility.h. `what`: "initial state",
+/// "solution" ... (for the message).
+void RequireMechanizable(const NavState& s, const std::string& source, const std::string& what);
 
 struct PureInsOptions {
   StrapdownOptions strapdown;
@@ -38,7 +53,9 @@ NavState InitialStateFromNav(NavReader& nav, std::optional<double> start_s);
 /// Runs the mechanization from `initial` over the IMU samples with t_s > initial.t_s.
 /// `output` (may be empty) receives the solution at the output epochs. `truth` (may be
 /// null) is compared at each of its epochs inside the run, interpolating the solution
-/// between IMU epochs. Throws InputError on bad input.
+/// between IMU epochs. Throws InputError on bad input, and when the solution is not
+/// mechanizable (RequireMechanizable, naming the IMU file; the caller checks `initial`
+/// naming where it came from).
 PureInsResult RunPureIns(ImuReader& imu, const NavState& initial, const PureInsOptions& options,
                          const std::function<void(const NavState&)>& output,
                          NavReader* truth = nullptr);

@@ -136,9 +136,12 @@ TEST(Cli, BadInputLeavesNoPartialOutput) {
   const RunResult r = Navtwin("ins --imu " + imu + " --init_from " + nav + " --out " + dir + "/out");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("line 3"), std::string::npos) << r.err;
-  EXPECT_FALSE(Exists(dir + "/out/nav.nav"));
-  // No temporary file left behind either: the output folder is empty.
-  DIR* d = ::opendir((dir + "/out").c_str());
+  // No temporary file and no output folder left behind either: the run created the folder.
+  EXPECT_FALSE(Exists(dir + "/out"));
+  // A folder that existed before stays (empty).
+  ASSERT_EQ(::mkdir((dir + "/existing").c_str(), 0755), 0);
+  EXPECT_EQ(Navtwin("ins --imu " + imu + " --init_from " + nav + " --out " + dir + "/existing").exit_code, 1);
+  DIR* d = ::opendir((dir + "/existing").c_str());
   ASSERT_NE(d, nullptr);
   int entries = 0;
   while (const dirent* e = ::readdir(d)) entries += e->d_name[0] != '.';

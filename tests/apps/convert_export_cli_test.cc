@@ -1,6 +1,7 @@
 // `navtwin convert` to KML, GPX and RTKLIB .pos (core/io/track_export.h): the format from
 // the output's extension, the .pos read back by `navtwin info`, and the refusals (no --std
 // for .pos, an epoch std.csv lacks), each with nothing written.
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -57,6 +58,22 @@ TEST(ConvertExport, KmlGpxAndPosFromTheExtension) {
   const RunResult gpx = Navtwin("convert --in " + d + "/nav.nav --out " + d + "/t.gpx");
   ASSERT_EQ(gpx.exit_code, 0) << gpx.err;
   EXPECT_NE(ReadAll(d + "/t.gpx").find("<time>"), std::string::npos);
+}
+
+TEST(ConvertExport, InfoAndConvertRefuseAValueThatOverflowsInSiUnits) {
+  // 1e308 g is finite; in m/s^2 it is not. Both commands name the file, line and field.
+  const std::string dir = MakeTempDir("overflow");
+  const std::string imu = dir + "/imu.csv";
+  std::ofstream(imu) << "t_s,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,acc_x_g,acc_y_g,acc_z_g\n"
+                        "0,0,0,0,0,0,1\n0.01,0,0,0,0,1e308,1\n0.02,0,0,0,0,0,1\n";
+  for (const std::string& command : {"info " + imu, "convert --in " + imu + " --out " + dir + "/imu.txt"}) {
+    const RunResult r = Navtwin(command);
+    EXPECT_EQ(r.exit_code, 1) << command;
+    for (const char* part : {"imu.csv", "line 3", "field 'acc_y_g'", "finite"}) {
+      EXPECT_NE(r.err.find(part), std::string::npos) << command << ": " << part << " not in " << r.err;
+    }
+  }
+  EXPECT_FALSE(Exists(dir + "/imu.txt"));
 }
 
 TEST(ConvertExport, RefusalsWriteNothing) {

@@ -50,6 +50,17 @@ TEST(AnsflTest, ProcessedDotRatesBecomeIncrementsInSensorAxes) {
   EXPECT_NEAR(s[0].dv_b_mps.x(), 0.1 * s[0].dt_s, 1e-15);
 }
 
+TEST(AnsflTest, ImplausibleRatesAndFieldsAreRefused) {
+  const std::string dir = MakeTempDir();
+  std::string text = std::string(kDotHeader) + DotRow(0.0) + "0.008333,0,0,0,0.1,0,9.81,0,-1.1e16,90\n" + DotRow(0.016666);
+  const std::string path = WriteFile(dir + "/IMU_1.csv", text);
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflImu(path)); }, {path, "line 3", "field 'Gyr_Y'", "implausible angular rate"});
+  const std::string header =
+      "SampleTimeFine,Euler_X,Euler_Y,Euler_Z,Acc_X,Acc_Y,Acc_Z,Gyr_X,Gyr_Y,Gyr_Z,Mag_X,Mag_Y,Mag_Z,\n";
+  const std::string raw = WriteFile(dir + "/Xsens_DOT9.csv", header + "1000,0,0,0,0,0,9.8,0,0,30,-0.5,0.2,1e307,\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenAnsflDotRawMag(raw)); }, {raw, "line 2", "field 'Mag_Z'", "implausible magnetic field"});
+}
+
 TEST(AnsflTest, LostSamplePatternIsRetimed) {
   const std::string dir = MakeTempDir();
   // Rows at 0, P, 2P, then the lost-sample pattern: 4P (really 3P), 4P again, then 5P.

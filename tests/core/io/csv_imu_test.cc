@@ -101,5 +101,31 @@ TEST(CsvImuTest, BadRowsNameLineAndField) {
   ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(header_only)); }, {"no samples"});
 }
 
+TEST(CsvImuTest, ValuesThatOverflowInSiUnitsAreRefused) {
+  // 1e308 g is finite, 1e308 g * 9.80665 m/s^2 per g is not: checked after the scaling.
+  const std::string head = "t_s,gyro_x_rad_s,gyro_y_rad_s,gyro_z_rad_s,acc_x_g,acc_y_g,acc_z_g\n";
+  const std::string g = WriteTempFile("g.csv", head + "0,0,0,0,0,0,1\n0.01,0,0,0,1e308,0,1\n0.02,0,0,0,0,0,1\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(g)); }, {g, "line 3", "field 'acc_x_g'", "finite"});
+  const std::string ms = WriteTempFile("ms.csv", "t_ms,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
+                                                 "0,0,0,0,0,0,0\n1,0,0,0,0,0,0\n");
+  EXPECT_EQ(ReadAllSamples(*OpenCsvImu(ms)).size(), 2u);
+}
+
+TEST(CsvImuTest, ImplausibleRatesAndIncrementsAreRefused) {
+  const std::string rates = "t_s,gyro_x_dps,gyro_y_dps,gyro_z_dps,acc_x_mps2,acc_y_mps2,acc_z_mps2\n";
+  const std::string gyro = WriteTempFile("gyro.csv", rates + "0,0,0,0,0,0,9.8\n0.01,0,2e4,0,0,0,9.8\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(gyro)); },
+                   {gyro, "line 3", "field 'gyro_y_dps'", "implausible angular rate"});
+  const std::string acc = WriteTempFile("acc.csv", rates + "0,0,0,0,0,0,9.8\n0.01,0,0,0,0,-1e16,9.8\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(acc)); },
+                   {acc, "line 3", "field 'acc_y_mps2'", "implausible specific force"});
+  const std::string inc = "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n";
+  const std::string dv = WriteTempFile("dv.csv", inc + "0,0,0,0,0,0,0.098\n0.01,0,0,0,0,0,1e16\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(dv)); },
+                   {dv, "line 3", "field 'dv_z_mps'", "implausible velocity increment"});
+  const std::string t = WriteTempFile("t.csv", inc + "0,0,0,0,0,0,0.098\n1e16,0,0,0,0,0,0.098\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenCsvImu(t)); }, {t, "line 3", "field 't_s'", "implausible time"});
+}
+
 }  // namespace io_csv_imu_test
 }  // namespace navtwin

@@ -117,6 +117,22 @@ TEST(CsvMagBaroTest, BadMagInputNamesFileLineAndField) {
   bad("nan.csv", header + "0,nan,2,3\n", {"line 2", "mx_uT", "not a finite number"});
   bad("back.csv", header + "0,1,2,3\n0.2,1,2,3\n0.1,1,2,3\n",
       {"line 4", "t_s", "does not increase"});
+  // Finite in gauss, infinite in uT (x 100): checked after the scaling.
+  bad("gauss_overflow.csv", "t_s,mx_G,my_G,mz_G\n0,0.2,0,0.4\n0.1,0.2,1e307,0.4\n",
+      {"gauss_overflow.csv", "line 3", "field 'my_G'", "finite"});
+  bad("huge_field.csv", header + "0,20,0,40\n0.1,20,1e16,40\n",
+      {"line 3", "field 'my_uT'", "implausible magnetic field"});
+}
+
+TEST(CsvMagBaroTest, ImplausibleBaroValuesAreRefused) {
+  const std::string header = "t_s,pressure_pa,altitude_m,temperature_degC\n";
+  const auto bad = [](const std::string& name, const std::string& text, std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, text);
+    ExpectInputError([&] { ReadAllSamples(*OpenCsvBaro(path)); }, parts);
+  };
+  bad("pressure.csv", header + "0,101325,,20\n0.1,1e16,,20\n", {"line 3", "field 'pressure_pa'", "implausible pressure"});
+  bad("altitude.csv", header + "0,,100,20\n0.1,,1e16,20\n", {"line 3", "field 'altitude_m'", "implausible height"});
+  bad("time.csv", header + "0,101325,,20\n1e16,101325,,20\n", {"line 3", "field 't_s'", "implausible time"});
 }
 
 TEST(CsvMagBaroTest, BadBaroInputNamesFileLineAndField) {

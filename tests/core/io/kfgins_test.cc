@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/io/open.h"
+#include "core/io/text_line.h"
 #include "core/rotation.h"
 #include "tests/core/io/io_test_util.h"
 
@@ -166,6 +167,118 @@ TEST(KfginsTest, WritersRefuseValuesTheReadersWouldReject) {
   ImuSample s;
   s.dv_b_mps.x() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(wi.Write(s), std::invalid_argument);
+}
+
+TEST(KfginsTest, NavWriterRefusesImpossibleStates) {
+  NavState ok;
+  ok.t_s = 12.5;
+  ok.lat_rad = 0.5;
+  ok.h_m = 100.0;
+  const auto refused = [](const NavState& s, const std::string& part) {
+    TextLine line;
+    try {
+      AppendNavFields(s, ' ', &line);
+      ADD_FAILURE() << "not refused: " << part;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("t = 12.5 s"), std::string::npos) << e.what();
+    }
+  };
+  NavState s = ok;
+  s.lat_rad = -180.9 * kDegToRad;
+  refused(s, "latitude");
+  s = ok;
+  s.h_m = 7e19;
+  refused(s, "height");
+  s = ok;
+  s.h_m = -4881946.0;
+  refused(s, "height");
+  s = ok;
+  s.v_n_mps.x() = -5.7e9;
+  refused(s, "velocity");
+  // At the limits: written.
+  s = ok;
+  s.lat_rad = -0.5 * kPi;
+  s.h_m = -12e3;
+  TextLine line;
+  AppendNavFields(s, ' ', &line);
+  s.h_m = 1e7;
+  AppendNavFields(s, ' ', &line);
+}
+
+TEST(KfginsTest, NavWriterWrapsTheLongitude) {
+  NavState s;
+  s.lon_rad = 200.0 * kDegToRad;  // past the antimeridian: -160 deg
+  const std::string path = TempFilePath("wrapped.nav");
+  KfginsNavWriter w(path);
+  w.Write(s);
+  s.t_s = 1.0;
+  s.lon_rad = -kPi;  // -180 deg stays as it is
+  w.Write(s);
+  w.Commit();
+  const std::vector<NavState> out = ReadAllSamples(*OpenKfginsNav(path));
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out[0].lon_rad * kRadToDeg, -160.0, 1e-12);
+  EXPECT_NEAR(out[1].lon_rad * kRadToDeg, -180.0, 1e-12);
+}
+
+TEST(KfginsTest, SubnormalSigmaIsRefused) {
+  const std::string path = WriteTempFile("denormal_sigma.txt",
+                                         "100.0 30.0 114.0 20.0 0.5 0.5 1.0\n"
+                                         "101.0 30.0 114.0 20.0 0.5 1e-320 1.0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(path)); },
+                   {path, "line 2", "field 'sigma_e'", "subnormal"});
+}
+
+// Finite but absurd values (core/io/plausibility.h): each refused where it is read, naming
+// file, line, field, the value and the limit.
+TEST(KfginsTest, ImplausibleImuValuesAreRefused) {
+  const std::string good = "0.01 1e-4 -0.00113 2e-5 0.001 -0.002 -0.0980665\n";
+  const auto imu = [&](const std::string& name, const std::string& third_line,
+                       std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, "0.00 1e-4 -0.00113 2e-5 0.001 -0.002 -0.0980665\n" + good +
+                                                     third_line + "0.03 0 0 0 0 0 -0.0980665\n");
+    ExpectInputError([&] { ReadAllSamples(*OpenKfginsImu(path)); }, parts);
+  };
+  // One deleted byte: -0.00113 -> -1.13e16 ("-1.13e-16" lost its exponent sign).
+  imu("deleted_byte.txt", "0.02 1e-4 -1.13e16 2e-5 0.001 -0.002 -0.0980665\n",
+      {"line 3", "field 'dtheta_y'", "implausible angle increment", "-1.13e+16"});
+  imu("huge_dv.txt", "0.02 1e-4 -0.00113 2e-5 1e300 -0.002 -0.0980665\n",
+      {"line 3", "field 'dv_x'", "implausible velocity increment"});
+  imu("huge_time.txt", "1e16 1e-4 -0.00113 2e-5 0.001 -0.002 -0.0980665\n",
+      {"line 3", "field 't'", "implausible time", "1e+16"});
+  // 1e-4 rad in 0.01 s is 0.57 deg/s; 1.7 rad in 0.01 s (1e4 deg/s) still passes.
+  const std::string fast = WriteTempFile("fast.txt", "0.00 1.7 0 0 0 0 0\n0.01 1.7 0 0 97 0 0\n");
+  EXPECT_EQ(ReadAllSamples(*OpenKfginsImu(fast)).size(), 2u);
+}
+
+TEST(KfginsTest, ImplausibleGnssAndNavValuesAreRefused) {
+  const std::string fix = "100.0 30.0 114.0 20.0 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n";
+  const auto gnss = [&](const std::string& name, const std::string& line2, std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, fix + line2);
+    ExpectInputError([&] { ReadAllSamples(*OpenKfginsGnss(path)); }, parts);
+  };
+  gnss("height.txt", "101.0 30.0 114.0 1e16 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'h'", "implausible height"});
+  gnss("lon.txt", "101.0 30.0 1e16 20.0 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'lon'", "implausible longitude"});
+  gnss("sigma.txt", "101.0 30.0 114.0 20.0 1e9 0.5 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'sigma_n'", "implausible standard deviation", "1e+09"});
+  gnss("tiny_sigma.txt", "101.0 30.0 114.0 20.0 0.5 1e-15 1.0 1 2 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'sigma_e'", "implausible standard deviation"});
+  gnss("velocity.txt", "101.0 30.0 114.0 20.0 0.5 0.5 1.0 1 -1e16 3 0.1 0.1 0.1\n",
+       {"line 2", "field 'v_e'", "implausible velocity"});
+  gnss("vsigma.txt", "101.0 30.0 114.0 20.0 0.5 0.5 1.0 1 2 3 0.1 1e300 0.1\n",
+       {"line 2", "field 'sigma_ve'", "implausible standard deviation"});
+  gnss("time.txt", "1e16 30.0 114.0 20.0 0.5 0.5 1.0 1 2 3 0.1 0.1 0.1\n", {"line 2", "field 't'", "implausible time"});
+  const std::string nav_line = "2381 100.0 30.0 114.0 20.0 1 2 3 0 0 90\n";
+  const auto nav = [&](const std::string& name, const std::string& line2, std::initializer_list<std::string> parts) {
+    const std::string path = WriteTempFile(name, nav_line + line2);
+    ExpectInputError([&] { ReadAllSamples(*OpenKfginsNav(path)); }, parts);
+  };
+  nav("nav_h.nav", "2381 101.0 30.0 114.0 -1e16 1 2 3 0 0 90\n", {"line 2", "field 'h'", "implausible height"});
+  nav("nav_v.nav", "2381 101.0 30.0 114.0 20.0 1 2 3e16 0 0 90\n", {"line 2", "field 'v_d'", "implausible velocity"});
+  nav("nav_t.nav", "2381 1e16 30.0 114.0 20.0 1 2 3 0 0 90\n", {"line 2", "field 'sow'", "implausible time"});
 }
 
 TEST(KfginsTest, UncommittedWriterLeavesNoFile) {

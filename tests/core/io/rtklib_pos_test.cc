@@ -48,6 +48,22 @@ TEST(RtklibPosTest, CalendarTimeLlhAndVelocity) {
   EXPECT_EQ(g[0].vel_std_ned_mps, Eigen::Vector3d(0.04, 0.05, 0.06));
 }
 
+TEST(RtklibPosTest, ImplausibleValuesAreRefused) {
+  const std::string good = std::string(kHeader) + "2025/08/28 17:30:39.749   40.096691600 -105.147166500" + kTail;
+  const std::string height = WriteTempFile(
+      "height.pos", good + "2025/08/28 17:30:39.999   40.096691600 -105.147166500   1e16   1   25   0.0100   "
+                           "0.0200   0.0300   0.0000   0.0000   0.0000   0.00    0.0   0.1 0.2 0.3  0.04 0.05 0.06 0 0 0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(height)); }, {height, "line 4", "field 'height'", "implausible height"});
+  const std::string sigma = WriteTempFile(
+      "sigma.pos", good + "2025/08/28 17:30:39.999   40.096691600 -105.147166500   1601.4   1   25   0.0100   "
+                          "0.0200   1e9   0.0000   0.0000   0.0000   0.00    0.0   0.1 0.2 0.3  0.04 0.05 0.06 0 0 0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(sigma)); }, {"line 4", "field 'sdu'", "implausible standard deviation"});
+  const std::string vel = WriteTempFile(
+      "vel.pos", good + "2025/08/28 17:30:39.999   40.096691600 -105.147166500   1601.4   1   25   0.0100   "
+                        "0.0200   0.03   0.0000   0.0000   0.0000   0.00    0.0   0.1 -1e16 0.3  0.04 0.05 0.06 0 0 0\n");
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibPos(vel)); }, {"line 4", "field 've'", "implausible velocity"});
+}
+
 TEST(RtklibPosTest, WeekTowTimeAndNoVelocityColumns) {
   const std::string path = WriteTempFile(
       "weektow.pos",

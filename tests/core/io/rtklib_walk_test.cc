@@ -133,6 +133,28 @@ TEST(RtklibWalkTest, MalformedLinesOtherThanTheCutEndsAreErrors) {
                    {path, "line 10", "expected 7 columns, found 3"});
 }
 
+TEST(RtklibWalkTest, ValuesThatOverflowInSiUnitsAreRefused) {
+  const std::string dir = MakeTempDir();
+  Recording rec;
+  rec.lines = 50;
+  const std::string path = rec.Write(dir);
+  std::string text;
+  {
+    std::ifstream in(path, std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // Line 10's ax "0.010" becomes "1e308" (g; the same length keeps the tags valid): inf in m/s^2.
+  std::size_t pos = 0;
+  for (int k = 0; k < 9; ++k) pos = text.find('\n', pos) + 1;
+  std::ofstream(path, std::ios::binary) << text.substr(0, pos) + "1e308" + text.substr(pos + 5);
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImu(path)); }, {path, "line 10", "field 'ax'", "finite"});
+  const std::string sf = dir + "/overflow_sf.csv";
+  std::ofstream(sf) << "1756402240.9610000,0,0,1,0,0,0.5,0,0,0,0\n"
+                       "1756402240.9670007,0,0,1e308,0,0,0.5,0,0,0,0\n"
+                       "1756402240.9730017,0,0,1,0,0,0.5,0,0,0,0\n";
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImuSf(sf)); }, {sf, "line 2", "field 'az'", "finite"});
+}
+
 TEST(RtklibWalkTest, BadTagFilesAreRefused) {
   const std::string dir = MakeTempDir();
   Recording rec;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,9 @@ TEST(TextReaderTest, RequirePositiveRejectsZeroAndNegative) {
   ExpectInputError([] { RequirePositive(0.0, "f", 7, "sigma_n"); },
                    {"line 7", "field 'sigma_n'", "must be > 0"});
   ExpectInputError([] { RequirePositive(-1.0, "f", 7, "sigma_n"); }, {"must be > 0"});
+  // Subnormal: > 0, but 1/sigma^2 overflows and the value has lost its precision.
+  ExpectInputError([] { RequirePositive(1e-320, "f", 7, "sigma_n"); }, {"f", "line 7", "sigma_n", "subnormal"});
+  RequirePositive(std::numeric_limits<double>::min(), "f", 1, "sigma");
 }
 
 TEST(TextReaderTest, IncreasingTimeRejectsRepeatsAndStepsBack) {

@@ -233,6 +233,31 @@ TEST(ULogTest, ImuOldFloatIntegralSecondsAndMissingIntegral) {
   EXPECT_NEAR(zs[0].dtheta_b_rad.x(), 0.005, 1e-12);  // 1 rad/s * 5 ms from time tags
 }
 
+TEST(ULogTest, ImplausibleRatesAndFieldsNameByteOffsetAndField) {
+  // A float gyro rate of 1e16 rad/s (finite, absurd): refused at its record.
+  ULogWriter w = ImuLog();
+  w.Data(0, ImuData(1'000'000, 0.5f, 4000, -9.8f, 4000));
+  const long long bad_at = w.offset();
+  w.Data(0, ImuData(1'005'000, 1e16f, 5000, -9.8f, 5000));
+  auto reader = OpenULogImu(w.Save("imu_absurd"));
+  ImuSample s;
+  ASSERT_TRUE(reader->Next(&s));
+  const InputError e = CatchInputError([&] { reader->Next(&s); });
+  EXPECT_EQ(e.byte_offset(), bad_at);
+  EXPECT_EQ(e.field(), "sensor_combined.gyro_rad");
+  EXPECT_NE(std::string(e.what()).find("implausible angular rate"), std::string::npos) << e.what();
+
+  ULogWriter m;
+  m.Format("sensor_mag:uint64_t timestamp;float x;float y;float z;")
+      .Subscribe(0, 0, "sensor_mag")
+      .Data(0, Bytes().U64(800).F32(0.5f).F32(3e30f).F32(-0.25f));
+  auto mag = OpenULogMag(m.Save("mag_absurd"));
+  MagSample ms;
+  const InputError em = CatchInputError([&] { mag->Next(&ms); });
+  EXPECT_EQ(em.field(), "sensor_mag.y");
+  EXPECT_NE(std::string(em.what()).find("implausible magnetic field"), std::string::npos) << em.what();
+}
+
 TEST(ULogTest, RepeatedTimeIsSkippedBackwardsTimeNamesByteOffset) {
   ULogWriter w = ImuLog();
   w.Data(0, ImuData(1'000'000, 0.f, 5000, -9.8f, 5000))
