@@ -6,7 +6,9 @@
 // the reader's unit scaling) and throw InputError with the value and the limit.
 #pragma once
 
+#include <cmath>
 #include <string>
+#include <string_view>
 
 #include "core/units.h"
 
@@ -46,20 +48,58 @@ constexpr double kMaxMagneticField_uT = 1e4;
 /// altitude sensor.
 constexpr double kMaxPressure_pa = 1e7;
 
+/// Throws InputError(path, line, field) naming the value, its quantity and the limits.
+[[noreturn]] void Refuse(double value, double lo, double hi, const char* quantity, const char* unit,
+                         const std::string& path, long line, std::string_view field);
+
+/// Throws (Refuse) unless lo <= value <= hi (NaN included). Inline: the readers call it for
+/// every number of every row, and only a refusal builds a message.
+inline void Within(double value, double lo, double hi, const char* quantity, const char* unit,
+                   const std::string& path, long line, std::string_view field) {
+  if (value >= lo && value <= hi) return;
+  Refuse(value, lo, hi, quantity, unit, path, line, field);
+}
+
 /// Each throws InputError(path, line, field, ...) naming the value and the limit when the
 /// value is outside its plausible range (or not finite).
-void Time(double t_s, const std::string& path, long line, const std::string& field);
-void AngularRate(double w_radps, const std::string& path, long line, const std::string& field);
-void SpecificForce(double f_mps2, const std::string& path, long line, const std::string& field);
+inline void Time(double t_s, const std::string& path, long line, std::string_view field) {
+  Within(t_s, -kMaxAbsTime_s, kMaxAbsTime_s, "time", "s", path, line, field);
+}
+inline void AngularRate(double w_radps, const std::string& path, long line, std::string_view field) {
+  Within(w_radps, -kMaxAngularRate_radps, kMaxAngularRate_radps, "angular rate", "rad/s", path, line, field);
+}
+inline void SpecificForce(double f_mps2, const std::string& path, long line, std::string_view field) {
+  Within(f_mps2, -kMaxSpecificForce_mps2, kMaxSpecificForce_mps2, "specific force", "m/s^2", path, line, field);
+}
 /// Increments over dt_s: |dtheta| <= kMaxAngularRate_radps dt, |dv| <= kMaxSpecificForce_mps2 dt.
-void AngleIncrement(double dtheta_rad, double dt_s, const std::string& path, long line, const std::string& field);
-void VelocityIncrement(double dv_mps, double dt_s, const std::string& path, long line, const std::string& field);
-void Latitude(double lat_rad, const std::string& path, long line, const std::string& field);
-void Longitude(double lon_rad, const std::string& path, long line, const std::string& field);
-void Height(double h_m, const std::string& path, long line, const std::string& field);
-void Velocity(double v_mps, const std::string& path, long line, const std::string& field);
-void Sigma(double sigma, const std::string& path, long line, const std::string& field);
-void MagneticField(double m_uT, const std::string& path, long line, const std::string& field);
-void Pressure(double p_pa, const std::string& path, long line, const std::string& field);
+inline void AngleIncrement(double dtheta_rad, double dt_s, const std::string& path, long line, std::string_view field) {
+  const double limit = kMaxAngularRate_radps * std::abs(dt_s);
+  Within(dtheta_rad, -limit, limit, "angle increment", "rad", path, line, field);
+}
+inline void VelocityIncrement(double dv_mps, double dt_s, const std::string& path, long line, std::string_view field) {
+  const double limit = kMaxSpecificForce_mps2 * std::abs(dt_s);
+  Within(dv_mps, -limit, limit, "velocity increment", "m/s", path, line, field);
+}
+inline void Latitude(double lat_rad, const std::string& path, long line, std::string_view field) {
+  Within(lat_rad * kRadToDeg, -90.0, 90.0, "latitude", "deg", path, line, field);
+}
+inline void Longitude(double lon_rad, const std::string& path, long line, std::string_view field) {
+  Within(lon_rad * kRadToDeg, -360.0, 360.0, "longitude", "deg", path, line, field);
+}
+inline void Height(double h_m, const std::string& path, long line, std::string_view field) {
+  Within(h_m, kMinHeight_m, kMaxHeight_m, "height", "m", path, line, field);
+}
+inline void Velocity(double v_mps, const std::string& path, long line, std::string_view field) {
+  Within(v_mps, -kMaxSpeed_mps, kMaxSpeed_mps, "velocity", "m/s", path, line, field);
+}
+inline void Sigma(double sigma, const std::string& path, long line, std::string_view field) {
+  Within(sigma, kMinSigma, kMaxSigma, "standard deviation", "(SI units)", path, line, field);
+}
+inline void MagneticField(double m_uT, const std::string& path, long line, std::string_view field) {
+  Within(m_uT, -kMaxMagneticField_uT, kMaxMagneticField_uT, "magnetic field", "uT", path, line, field);
+}
+inline void Pressure(double p_pa, const std::string& path, long line, std::string_view field) {
+  Within(p_pa, 0.0, kMaxPressure_pa, "pressure", "Pa", path, line, field);
+}
 
 }  // namespace navtwin::plausible
