@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <limits>
@@ -179,7 +180,10 @@ InitConfig ParseInit(const ConfigNode& n, const std::string& config_path, double
     InsState s;
     if (has_file) {
       if (n.Has("time_s")) n.Fail("time_s", "the time comes from nav_file");
-      const std::string nav_path = Resolve(config_path, n.String("nav_file", ""));
+      const std::string nav_file = n.String("nav_file", "");
+      if (nav_file.empty()) n.Fail("nav_file", "empty: name the navigation file of the initial state");
+      const std::string nav_path = Resolve(config_path, nav_file);
+      if (!std::filesystem::is_regular_file(nav_path)) n.Fail("nav_file", "no such file: " + nav_path);
       auto reader = OpenNav(nav_path);
       s.nav = InitialStateFromNav(*reader, std::isfinite(start_time_s)
                                                ? std::optional<double>(start_time_s)

@@ -162,6 +162,17 @@ init: {source: static}
   ExpectInputError([&] { LoadGnssInsConfig(init); }, {init, "line 8", "init.position_std_m"});
 }
 
+// An empty or missing init.nav_file names the configuration, line and key (it once gave
+// "navtwin navigate: : cannot open the file").
+TEST(GnssInsConfig, EmptyOrMissingNavFileNamesTheKey) {
+  const std::string head = "imu_noise:\n  gyro_arw_deg_sqrt_h: 0.1\n  accel_vrw_m_s_sqrt_h: 0.1\n"
+                           "  gyro_bias_std_deg_h: 1\n  accel_bias_std_ug: 100\ninit:\n  source: given\n";
+  const std::string empty = WriteTempFile("empty_nav.yaml", head + "  nav_file: \"\"\n");
+  ExpectInputError([&] { LoadGnssInsConfig(empty); }, {empty, "line 8", "init.nav_file", "empty"});
+  const std::string missing = WriteTempFile("missing_nav.yaml", head + "  nav_file: nowhere.nav\n");
+  ExpectInputError([&] { LoadGnssInsConfig(missing); }, {missing, "line 8", "init.nav_file", "no such file"});
+}
+
 // The GNSS installation keys (docs/gnss-ins.md "GNSS installation parameters"): defaults off,
 // 0.5 m, 0 s and 0.2 s; the lever arm's std a scalar or per axis; the offset within +-1 s.
 TEST(GnssInsConfig, GnssInstallationKeys) {
