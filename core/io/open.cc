@@ -76,32 +76,93 @@ FileFormat FromHeader(const HeaderColumns& h) {
   return FileFormat::kUnknown;
 }
 
-FileFormat FromNumbers(const std::string& path, const std::vector<std::string_view>& f) {
-  std::vector<double> v;
-  for (std::string_view text : f) {
+/// Data lines looked at to tell a numeric format: a corrupt first line does not decide.
+constexpr int kDetectLines = 5;
+/// KF-GINS 7 columns near (0 deg, 0 deg): GNSS fixes come at 25 Hz or slower, IMU samples at
+/// 50 Hz or faster, so the time step between two lines tells them apart.
+constexpr double kGnssMinStep_s = 0.03;
+
+/// Up to `count` data lines (not blank, not a '#' note) with their 1-based line numbers;
+/// throws InputError for a file without any.
+std::vector<std::pair<long, std::string>> DataLines(const std::string& path, int count) {
+  LineReader lines(path);
+  std::vector<std::pair<long, std::string>> out;
+  std::string line;
+  while (static_cast<int>(out.size()) < count && lines.Next(&line)) {
+    if (!IsBlank(line) && Trim(line).front() != '#') out.emplace_back(lines.line_number(), line);
+  }
+  if (out.empty()) throw InputError(path, 0, "", "the file is empty");
+  return out;
+}
+
+/// The numbers of a line split on blanks and commas; false when a field is not a number.
+bool Numbers(const std::string& path, const std::string& line, std::vector<double>* v) {
+  std::vector<std::string_view> fields;
+  SplitLoose(Trim(line), &fields);
+  v->clear();
+  for (std::string_view text : fields) {
     try {
-      v.push_back(ParseDouble(text, path, 1, ""));
+      v->push_back(ParseDouble(text, path, 1, ""));
     } catch (const InputError&) {
-      return FileFormat::kUnknown;
+      return false;
     }
   }
-  switch (v.size()) {
-    case 7:
-      return std::max(std::fabs(v[1]), std::fabs(v[2])) > kDegreesNotIncrement
-                 ? FileFormat::kKfginsGnss
-                 : FileFormat::kKfginsImu;
-    case 8:  // OB_GINS: an IMU with the odometer speed
-      return FileFormat::kKfginsImu;
-    case 11:
-      return v[0] > kEpochSecondsThreshold ? FileFormat::kRtklibWalkImuSf : FileFormat::kKfginsNav;
-    case 13:
-      return FileFormat::kKfginsGnss;
-    default:
-      return FileFormat::kUnknown;
+  return true;
+}
+
+/// The format of numeric data lines: the first line that is all numbers with a known count
+/// decides; for 7 columns (KF-GINS IMU or GNSS) latitude/longitude beyond 0.5 deg, else the
+/// time step to the next such line, say GNSS.
+FileFormat FromNumberLines(const std::string& path, const std::vector<std::pair<long, std::string>>& lines) {
+  std::vector<double> v, next;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (!Numbers(path, lines[i].second, &v)) continue;
+    switch (v.size()) {
+      case 7: {
+        if (std::max(std::fabs(v[1]), std::fabs(v[2])) > kDegreesNotIncrement) return FileFormat::kKfginsGnss;
+        for (std::size_t j = i + 1; j < lines.size(); ++j) {
+          if (Numbers(path, lines[j].second, &next) && next.size() == 7) {
+            return next[0] - v[0] >= kGnssMinStep_s ? FileFormat::kKfginsGnss : FileFormat::kKfginsImu;
+          }
+        }
+        return FileFormat::kKfginsImu;
+      }
+      case 8:  // OB_GINS: an IMU with the odometer speed
+        return FileFormat::kKfginsImu;
+      case 11:
+        return v[0] > kEpochSecondsThreshold ? FileFormat::kRtklibWalkImuSf : FileFormat::kKfginsNav;
+      case 13:
+        return FileFormat::kKfginsGnss;
+      default:
+        continue;
+    }
   }
+  return FileFormat::kUnknown;
+}
+
+/// Why a file's kind is unknown, as an InputError naming the line and the field.
+[[noreturn]] void RefuseUnknown(const std::string& path) {
+  const std::vector<std::pair<long, std::string>> lines = DataLines(path, 1);
+  const auto& [number, line] = lines.front();
+  std::vector<std::string_view> fields;
+  SplitCsv(Trim(line), &fields);
+  const char c = fields.front().empty() ? ' ' : fields.front().front();
+  if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z')) {
+    throw InputError(path, number, "header",
+                     "the columns are not a format navtwin reads (CSV IMU: t_s or t_ms with dtheta_x_rad, "
+                     "gyro_x_rad_s or gyro_x_dps; magnetometer: t_s with mx_uT, mx_G, mx_ga or mx_nT; barometer: t_s "
+                     "with pressure_pa or altitude_m; Xsens DOT and ANSFL files; docs/formats.md)");
+  }
+  SplitLoose(Trim(line), &fields);
+  for (std::size_t k = 0; k < fields.size(); ++k) ParseDouble(fields[k], path, number, "field " + std::to_string(k + 1));
+  throw InputError(path, number, "",
+                   std::to_string(fields.size()) + " numbers in the first data lines: the numeric formats have 7 "
+                   "(KF-GINS IMU or GNSS), 8 (OB_GINS IMU), 11 (KF-GINS navigation, rtklib-walk) or 13 (KF-GINS "
+                   "GNSS with velocity) columns (docs/formats.md)");
 }
 
 [[noreturn]] void Refuse(const std::string& path, const char* stream, FileFormat format) {
+  if (format == FileFormat::kUnknown) RefuseUnknown(path);
   throw InputError(
       path, 0, "",
       std::string("cannot read ") + stream + " from a file of kind " + FormatName(format));
@@ -152,19 +213,18 @@ FileSummary DescribeNav(const std::string& path, FileFormat format, std::vector<
 
 FileFormat DetectFormat(const std::string& path) {
   if (EndsWithNoCase(path, ".ulg") || StartsWithULogMagic(path)) return FileFormat::kULog;
-  const std::string line = FirstLine(path);
-  const std::string_view first = Trim(line);
+  const std::vector<std::pair<long, std::string>> lines = DataLines(path, kDetectLines);
+  const std::string_view first = Trim(lines.front().second);
   if (first.front() == '%') return FileFormat::kRtklibPos;
   std::vector<std::string_view> fields;
   SplitCsv(first, &fields);
   const char c = fields.front().empty() ? ' ' : fields.front().front();
   if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z')) {
     for (std::string_view& f : fields) f = StripUnit(f);
-    return FromHeader(HeaderColumns(fields, path, 1));
+    return FromHeader(HeaderColumns(fields, path, lines.front().first));
   }
   if (Exists(path + ".tag")) return FileFormat::kRtklibWalkImu;
-  SplitLoose(first, &fields);
-  return FromNumbers(path, fields);
+  return FromNumberLines(path, lines);
 }
 
 std::string FormatName(FileFormat format) {

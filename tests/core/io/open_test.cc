@@ -82,10 +82,32 @@ TEST(OpenTest, RefusesStreamsAKindDoesNotHold) {
   ExpectInputError([&] { OpenMag(imu); }, {"cannot read magnetometer samples"});
   ExpectInputError([&] { OpenBaro(imu); }, {"cannot read barometer samples"});
   const std::string unknown = WriteFile(d + "/five.txt", "1 2 3 4 5\n");
-  ExpectInputError([&] { OpenImu(unknown); }, {"of kind unknown"});
+  ExpectInputError([&] { OpenImu(unknown); }, {unknown, "line 1", "5 numbers", "7 (KF-GINS IMU or GNSS)"});
   ExpectInputError([&] { DescribeFile(unknown); }, {"not a recognised format"});
   const std::string empty = WriteFile(d + "/empty.txt", "");
   ExpectInputError([&] { OpenImu(empty); }, {empty, "empty"});
+}
+
+// Detection does not rest on the first line alone: a corrupt first data line leaves the
+// kind to the next lines (and the reader then names the bad line and field); a kind that
+// stays unknown names the line and the field; 7 columns near (0 deg, 0 deg) are told apart
+// by the time step (1 Hz GNSS, 200 Hz IMU).
+TEST(OpenTest, DetectionSurvivesACorruptFirstLineAndExplainsUnknownKinds) {
+  const std::string d = MakeTempDir();
+  const std::string corrupt = WriteFile(d + "/corrupt.txt",
+                                        "1.000 0 0 0x 0 0 -0.049\n1.005 0 0 0 0 0 -0.049\n1.010 0 0 0 0 0 -0.049\n");
+  EXPECT_EQ(DetectFormat(corrupt), FileFormat::kKfginsImu);
+  ImuSample s;
+  ExpectInputError([&] { OpenImu(corrupt)->Next(&s); }, {corrupt, "line 1", "0x"});
+  const std::string text = WriteFile(d + "/text.txt", "1.000 0 zero 0 0 0 -0.049\n");
+  ExpectInputError([&] { OpenImu(text); }, {text, "line 1", "field 3", "zero"});
+  const std::string header = WriteFile(d + "/header.csv", "# made by hand\ntime,ax,ay,az\n0,1,2,3\n");
+  ExpectInputError([&] { OpenImu(header); }, {header, "line 2", "header", "not a format navtwin reads"});
+  const std::string gnss = WriteFile(d + "/gnss_at_origin.txt",
+                                     "388000 0.10 0.20 20.1 0.01 0.01 0.02\n388001 0.10 0.20 20.1 0.01 0.01 0.02\n");
+  EXPECT_EQ(DetectFormat(gnss), FileFormat::kKfginsGnss);
+  const std::string imu = WriteFile(d + "/imu_200hz.txt", "1.000 0.1 0.2 0 0 0 -0.049\n1.005 0.1 0.2 0 0 0 -0.049\n");
+  EXPECT_EQ(DetectFormat(imu), FileFormat::kKfginsImu);
 }
 
 TEST(OpenTest, DescribesATextFile) {
