@@ -42,7 +42,7 @@ int Usage(const std::string& why) {
 std::string CommandLine() {
   std::ostringstream s;
   s << "navtwin calibrate-imu --rig " << FLAGS_rig;
-  if (FLAGS_rig == "handheld") {
+  if (FLAGS_rig == "handheld" && FLAGS_data.empty()) {
     s << " --imu " << FLAGS_imu << " --latitude_deg " << FLAGS_latitude_deg << " --height_m " << FLAGS_height_m;
   } else {
     s << " --data " << FLAGS_data;
@@ -62,13 +62,17 @@ calibration::ImuCalibrationResult Calibrate(bool recursive, std::vector<calibrat
         });
   }
   if (FLAGS_rig == "handheld") {
+    calibration::HandheldOptions options;
+    options.initial_still_s = FLAGS_initial_still_s;
+    if (!FLAGS_data.empty()) {
+      const calibration::HandheldData data = calibration::ReadHandheldRecord(FLAGS_data, &options);
+      return calibration::CalibrateHandheld(data, options);
+    }
     calibration::HandheldData data;
     data.imu_path = FLAGS_imu;
     data.imu = ReadAll(*OpenImu(FLAGS_imu, FLAGS_calibration, FLAGS_imu_temperature_degC));
     data.latitude_rad = FLAGS_latitude_deg * kDegToRad;
     data.height_m = FLAGS_height_m;
-    calibration::HandheldOptions options;
-    options.initial_still_s = FLAGS_initial_still_s;
     return calibration::CalibrateHandheld(data, options);
   }
   if (FLAGS_rig == "multiposition") return calibration::CalibrateMultiPositionRecord(FLAGS_data);
@@ -94,8 +98,10 @@ void WriteRunFolder(const calibration::ImuCalibrationResult& result, const Calib
 
 int RunCalibrateImu(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args.front() + "' (the record goes in --data)");
-  if (FLAGS_rig == "handheld") {
-    if (FLAGS_imu.empty()) return Usage("--rig handheld reads --imu FILE");
+  if (FLAGS_rig == "handheld" && !FLAGS_data.empty()) {
+    if (!FLAGS_imu.empty()) return Usage("--rig handheld: give --data RECORD or --imu FILE, not both");
+  } else if (FLAGS_rig == "handheld") {
+    if (FLAGS_imu.empty()) return Usage("--rig handheld reads --imu FILE (or a record: --data RECORD)");
     if (!std::isfinite(FLAGS_latitude_deg) || std::abs(FLAGS_latitude_deg) > 90.0) {
       return Usage("--rig handheld needs --latitude_deg (the place's latitude, for the local gravity)");
     }
@@ -145,9 +151,11 @@ Command CalibrateImuCommand() {
           "  - temperature: {order, latitude_deg, height_m, runs: [{temperature_degC, imu, trajectory}]},\n"
           "    one multi-position schedule per chamber temperature, or warm-up runs with\n"
           "    temperature: FILE (t_s,temperature_degC) instead (docs/calibration-temperature.md).\n"
-          "  - handheld (no rig; --imu FILE --latitude_deg L [--height_m H] [--initial_still_s 30]): the\n"
-          "    sensor put down by hand in 10 or more orientations, still 2 s or more each, after a still\n"
-          "    period at the start (docs/calibration-imu.md \"Without a rig\").\n"
+          "  - handheld (no rig; --imu FILE --latitude_deg L [--height_m H] [--initial_still_s 30], or a\n"
+          "    record --data RECORD: {imu, latitude_deg, height_m, initial_still_s, counts:\n"
+          "    {gyro_rad_s_per_count, accel_mps2_per_count}} for a CSV of raw counts): the sensor put\n"
+          "    down by hand in 10 or more orientations, still 2 s or more each, after a still period at\n"
+          "    the start (docs/calibration-imu.md \"Without a rig\").\n"
           "  Prints every parameter with one sigma and the parameters the data cannot observe (held\n"
           "  at 0); --out writes the calibration file that --calibration applies to IMU readers; --run_dir\n"
           "  the run folder (docs/run-folder.md: summary, calibration file, parameters, residuals before\n"

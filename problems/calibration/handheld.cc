@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -11,9 +12,13 @@
 #include <ceres/ceres.h>
 #include <Eigen/Eigenvalues>
 
+#include "core/config/yaml_config.h"
 #include "core/earth.h"
 #include "core/imu_error_model.h"
+#include "core/io/csv_series.h"
 #include "core/io/input_error.h"
+#include "core/io/open.h"
+#include "core/io/rate_to_increment.h"
 #include "core/units.h"
 #include "problems/calibration/imu_calibration_residuals.h"
 
@@ -372,7 +377,54 @@ ImuCalibrationResult MakeHandheldResult(const AccelFit& a, const GyroFit& gfit) 
   return r;
 }
 
+/// The raw-count CSV of a record's `counts` (ReadHandheldRecord) as increments.
+std::vector<ImuSample> ReadCountsCsv(const std::string& path, double gyro_rad_s_per_count, double accel_mps2_per_count) {
+  std::vector<ScalarSeries> columns;
+  for (const char* stem : {"gyro_x", "gyro_y", "gyro_z", "acc_x", "acc_y", "acc_z"}) {
+    columns.push_back(ReadScalarSeriesCsv(path, stem, {{"_counts", 1.0}}));
+  }
+  std::vector<ImuSample> out;
+  RateToIncrement increments;
+  for (std::size_t k = 0; k < columns.front().t_s.size(); ++k) {
+    RateSample r;
+    r.t_s = columns.front().t_s[k];
+    for (int i = 0; i < 3; ++i) {
+      r.gyro_radps(i) = columns[i].value[k] * gyro_rad_s_per_count;
+      r.acc_mps2(i) = columns[3 + i].value[k] * accel_mps2_per_count;
+    }
+    ImuSample s;
+    if (increments.Add(r, &s)) out.push_back(s);
+  }
+  return out;
+}
+
 }  // namespace
+
+HandheldData ReadHandheldRecord(const std::string& record_path, HandheldOptions* options) {
+  const ConfigNode root = LoadYamlFile(record_path);
+  root.RequireKeys({"imu", "latitude_deg", "height_m", "initial_still_s", "counts"});
+  if (!root.Has("imu")) root.Fail("imu", "missing: the IMU file of the hand-placed sequence");
+  if (!root.Has("latitude_deg")) root.Fail("latitude_deg", "missing: the latitude of the place (local gravity)");
+  HandheldData data;
+  data.latitude_rad = root.Double("latitude_deg", 0.0, -90.0, 90.0) * kDegToRad;
+  data.height_m = root.Double("height_m", 0.0, -1e4, 1e5);
+  options->initial_still_s = root.Positive("initial_still_s", options->initial_still_s);
+  std::filesystem::path imu(root.String("imu", ""));
+  if (imu.is_relative()) imu = std::filesystem::path(record_path).parent_path() / imu;
+  data.imu_path = imu.string();
+  if (root.Has("counts")) {
+    const ConfigNode counts = root.Child("counts");
+    counts.RequireKeys({"gyro_rad_s_per_count", "accel_mps2_per_count"});
+    for (const char* key : {"gyro_rad_s_per_count", "accel_mps2_per_count"}) {
+      if (!counts.Has(key)) counts.Fail(key, "required: the sensor's nominal sensitivity");
+    }
+    data.imu = ReadCountsCsv(data.imu_path, counts.Positive("gyro_rad_s_per_count", 1.0),
+                             counts.Positive("accel_mps2_per_count", 1.0));
+  } else {
+    data.imu = ReadAll(*OpenImu(data.imu_path));
+  }
+  return data;
+}
 
 ImuCalibrationResult CalibrateHandheld(const HandheldData& data, const HandheldOptions& options,
                                        StillDetection* detection) {

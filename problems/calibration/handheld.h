@@ -54,6 +54,15 @@ struct StillDetection {
   int intervals = 0;
 };
 
+/// A handheld record (YAML, `calibrate-imu --rig handheld --data RECORD`; paths relative to
+/// the record): {imu: FILE, latitude_deg, height_m (default 0), initial_still_s (default 30),
+/// counts: {gyro_rad_s_per_count, accel_mps2_per_count} (optional)}. Without `counts` the IMU
+/// file is any format navtwin reads; with it, a CSV of raw sensor counts (t_s or t_ms,
+/// gyro_x_counts, gyro_y_counts, gyro_z_counts, acc_x_counts, acc_y_counts, acc_z_counts)
+/// turned into rates with the nominal sensitivities (the calibration's scale factors absorb
+/// their error) and into increments by the trapezoid rule. Throws InputError (file, line, key).
+HandheldData ReadHandheldRecord(const std::string& record_path, HandheldOptions* options);
+
 /// Calibrates; throws std::runtime_error naming what is missing (no initial still period,
 /// too few still intervals or turns) and InputError for an IMU record that cannot be used.
 ImuCalibrationResult CalibrateHandheld(const HandheldData& data, const HandheldOptions& options = {},

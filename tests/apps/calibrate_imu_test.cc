@@ -154,6 +154,51 @@ TEST(CalibrateImuTest, HandheldFromTheImuFile) {
   EXPECT_NE(no_place.err.find("--latitude_deg"), std::string::npos) << no_place.err;
 }
 
+// A handheld record of raw counts: the simulated sequence written as integer counts of a
+// sensor with 0.001 rad/s and 0.001 m/s^2 per count, read with nominal sensitivities 1 %
+// high (gyro) and 2 % low (accelerometer): the scale factors and biases absorb the nominal
+// error, (1 + s) r - 1 and b r with r the nominal/true ratio.
+TEST(CalibrateImuTest, HandheldRecordOfRawCounts) {
+  const std::string dir = MakeTempDir("calibrate_counts");
+  ASSERT_EQ(Navtwin("simulate --scenario " + std::string(NAVTWIN_SOURCE_DIR) +
+                    "/data/calibration/handheld/scenario.yaml --seed 4 --out " + dir + "/sim")
+                .exit_code,
+            0);
+  constexpr double kGyroPerCount = 0.001, kAccelPerCount = 0.001, kGyroRatio = 1.01, kAccelRatio = 0.98;
+  std::ifstream in(dir + "/sim/imu.txt");
+  std::ofstream csv(dir + "/counts.csv");
+  csv << "t_s,gyro_x_counts,gyro_y_counts,gyro_z_counts,acc_x_counts,acc_y_counts,acc_z_counts\n";
+  double t = 0.0, previous = NAN, v[6];
+  while (in >> t >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5]) {
+    if (std::isfinite(previous)) {
+      const double dt = t - previous;
+      csv << t;
+      for (int i = 0; i < 6; ++i) csv << "," << std::lround(v[i] / dt / (i < 3 ? kGyroPerCount : kAccelPerCount));
+      csv << "\n";
+    }
+    previous = t;
+  }
+  csv.close();
+  std::ofstream(dir + "/record.yaml") << "imu: counts.csv\nlatitude_deg: 37.45\nheight_m: 300\ncounts:\n"
+                                         "  gyro_rad_s_per_count: " << kGyroPerCount * kGyroRatio
+                                      << "\n  accel_mps2_per_count: " << kAccelPerCount * kAccelRatio << "\n";
+  const RunResult r = Navtwin("calibrate-imu --rig handheld --data " + dir + "/record.yaml --format=json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const YAML::Node truth = YAML::LoadFile(dir + "/sim/errors.yaml")["imu"]["errors"];
+  const auto expect = [&r](const char* name, double expected) {
+    const std::string anchor = std::string("\"") + name + "\"";
+    const double value = JsonNumberAfter(r.out, anchor, "value"), sigma = JsonNumberAfter(r.out, anchor, "sigma");
+    ASSERT_TRUE(sigma > 0.0) << name;
+    // One draw each: 4 sigma (the second-order terms, misalignment x ratio error ~3e-5, are
+    // below a fifth of sigma).
+    EXPECT_LT(std::abs(value - expected) / sigma, 4.0) << name << " " << value << " +- " << sigma << " vs " << expected;
+  };
+  expect("accel.scale_factor.y", (1.0 + truth["accel"]["scale_factor_ppm"][1].as<double>() * 1e-6) * kAccelRatio - 1.0);
+  expect("accel.bias.x", truth["accel"]["bias_ug"][0].as<double>() * 9.80665e-6 * kAccelRatio);
+  expect("gyro.scale_factor.z", (1.0 + truth["gyro"]["scale_factor_ppm"][2].as<double>() * 1e-6) * kGyroRatio - 1.0);
+  EXPECT_EQ(Navtwin("calibrate-imu --rig handheld --data " + dir + "/record.yaml --imu x.txt").exit_code, 2);
+}
+
 TEST(CalibrateImuTest, PendulumRecordFromSimulatedMountings) {
   const std::string dir = MakeTempDir("pendulum_cli");
   std::string record = "latitude_deg: 37.45\nheight_m: 40\nruns:\n";
