@@ -78,9 +78,10 @@ FileFormat FromHeader(const HeaderColumns& h) {
 
 /// Data lines looked at to tell a numeric format: a corrupt first line does not decide.
 constexpr int kDetectLines = 5;
-/// KF-GINS 7 columns near (0 deg, 0 deg): GNSS fixes come at 25 Hz or slower, IMU samples at
-/// 50 Hz or faster, so the time step between two lines tells them apart.
-constexpr double kGnssMinStep_s = 0.03;
+/// KF-GINS 7 columns near (0 deg, 0 deg): a GNSS fix has positive sigmas in its last three
+/// columns and a height, or comes at 5 Hz or slower; IMU samples come at 5 Hz or faster and
+/// hold increments (|dtheta_z| < 0.5 rad) there.
+constexpr double kImuMaxStep_s = 0.2;
 
 /// Up to `count` data lines (not blank, not a '#' note) with their 1-based line numbers;
 /// throws InputError for a file without any.
@@ -111,8 +112,8 @@ bool Numbers(const std::string& path, const std::string& line, std::vector<doubl
 }
 
 /// The format of numeric data lines: the first line that is all numbers with a known count
-/// decides; for 7 columns (KF-GINS IMU or GNSS) latitude/longitude beyond 0.5 deg, else the
-/// time step to the next such line, say GNSS.
+/// decides; 7 columns (KF-GINS IMU or GNSS) are GNSS with latitude/longitude beyond 0.5 deg,
+/// else with positive sigmas and a height beyond 0.5 m or a time step of 0.2 s or more.
 FileFormat FromNumberLines(const std::string& path, const std::vector<std::pair<long, std::string>>& lines) {
   std::vector<double> v, next;
   for (std::size_t i = 0; i < lines.size(); ++i) {
@@ -120,9 +121,11 @@ FileFormat FromNumberLines(const std::string& path, const std::vector<std::pair<
     switch (v.size()) {
       case 7: {
         if (std::max(std::fabs(v[1]), std::fabs(v[2])) > kDegreesNotIncrement) return FileFormat::kKfginsGnss;
+        if (!(v[4] > 0.0 && v[5] > 0.0 && v[6] > 0.0)) return FileFormat::kKfginsImu;  // not sigmas
+        if (std::fabs(v[3]) > kDegreesNotIncrement) return FileFormat::kKfginsGnss;       // a height
         for (std::size_t j = i + 1; j < lines.size(); ++j) {
           if (Numbers(path, lines[j].second, &next) && next.size() == 7) {
-            return next[0] - v[0] >= kGnssMinStep_s ? FileFormat::kKfginsGnss : FileFormat::kKfginsImu;
+            return next[0] - v[0] >= kImuMaxStep_s ? FileFormat::kKfginsGnss : FileFormat::kKfginsImu;
           }
         }
         return FileFormat::kKfginsImu;

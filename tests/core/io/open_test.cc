@@ -91,7 +91,7 @@ TEST(OpenTest, RefusesStreamsAKindDoesNotHold) {
 // Detection does not rest on the first line alone: a corrupt first data line leaves the
 // kind to the next lines (and the reader then names the bad line and field); a kind that
 // stays unknown names the line and the field; 7 columns near (0 deg, 0 deg) are told apart
-// by the time step (1 Hz GNSS, 200 Hz IMU).
+// by the sigmas, the height and the time step.
 TEST(OpenTest, DetectionSurvivesACorruptFirstLineAndExplainsUnknownKinds) {
   const std::string d = MakeTempDir();
   const std::string corrupt = WriteFile(d + "/corrupt.txt",
@@ -108,6 +108,12 @@ TEST(OpenTest, DetectionSurvivesACorruptFirstLineAndExplainsUnknownKinds) {
   EXPECT_EQ(DetectFormat(gnss), FileFormat::kKfginsGnss);
   const std::string imu = WriteFile(d + "/imu_200hz.txt", "1.000 0.1 0.2 0 0 0 -0.049\n1.005 0.1 0.2 0 0 0 -0.049\n");
   EXPECT_EQ(DetectFormat(imu), FileFormat::kKfginsImu);
+  // A 20 Hz IMU whose dv happen to be positive (upside down) is still an IMU: no height.
+  const std::string slow = WriteFile(d + "/imu_20hz.txt", "1.00 0.01 0.02 0.001 0.01 0.02 0.49\n1.05 0.01 0.02 0.001 0.01 0.02 0.49\n");
+  EXPECT_EQ(DetectFormat(slow), FileFormat::kKfginsImu);
+  // A GNSS fix at sea level near (0, 0) at 1 Hz: the time step.
+  const std::string sea = WriteFile(d + "/gnss_sea_level.txt", "100 0.1 0.2 0.3 0.01 0.01 0.02\n101 0.1 0.2 0.3 0.01 0.01 0.02\n");
+  EXPECT_EQ(DetectFormat(sea), FileFormat::kKfginsGnss);
 }
 
 TEST(OpenTest, DescribesATextFile) {
