@@ -553,6 +553,28 @@ void CutSegments(const WarmUpRun& run, int run_index, const TemperatureCalibrati
 
 }  // namespace
 
+namespace {
+
+/// The warm-up segments as the static positions of the result (their residuals).
+std::vector<StaticPosition> SegmentPositions(const std::vector<WarmUpSegment>& segments) {
+  std::vector<StaticPosition> out;
+  for (const WarmUpSegment& seg : segments) {
+    StaticPosition p;
+    p.t0_s = seg.t0_s;
+    p.t1_s = seg.t1_s;
+    p.run = seg.run;
+    p.temperature_degC = seg.temperature_degC;
+    p.f_true_b_mps2 = seg.f_true_b_mps2;
+    p.f_mean_b_mps2 = seg.f_mean_b_mps2;
+    p.omega_true_b_radps = seg.omega_true_b_rad_per_s;
+    p.omega_mean_b_radps = seg.omega_mean_b_rad_per_s;
+    out.push_back(p);
+  }
+  return out;
+}
+
+}  // namespace
+
 WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const TemperatureCalibrationOptions& options) {
   const std::string what = "warm-up temperature calibration";
   if (options.order < 1) {
@@ -712,18 +734,7 @@ WarmUpCalibration CalibrateWarmUp(const std::vector<WarmUpRun>& runs, const Temp
   result.accel_residual_rms_mps2 = std::sqrt(accel_ss / (3.0 * m));
   result.gyro_residual_rms_rad_per_s = std::sqrt(gyro_ss / (3.0 * m));
   result.positions = positions;
-  for (const WarmUpSegment& seg : out.segments) {
-    StaticPosition p;
-    p.t0_s = seg.t0_s;
-    p.t1_s = seg.t1_s;
-    p.run = seg.run;
-    p.temperature_degC = seg.temperature_degC;
-    p.f_true_b_mps2 = seg.f_true_b_mps2;
-    p.f_mean_b_mps2 = seg.f_mean_b_mps2;
-    p.omega_true_b_radps = seg.omega_true_b_rad_per_s;
-    p.omega_mean_b_radps = seg.omega_mean_b_rad_per_s;
-    result.static_positions.push_back(p);
-  }
+  result.static_positions = SegmentPositions(out.segments);
   result.residuals = StaticResiduals(result.calibration, result.static_positions);
   const auto [t_min, t_max] = std::minmax_element(temperatures.begin(), temperatures.end());
   result.notes.push_back(std::to_string(runs.size()) + " warm-up run(s), " + std::to_string(positions) +
