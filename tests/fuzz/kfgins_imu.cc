@@ -1,0 +1,13 @@
+// Fuzz target: the KF-GINS IMU reader and its odometer column (core/io/kfgins.h).
+#include <cstddef>
+#include <cstdint>
+
+#include "core/io/kfgins.h"
+#include "tests/fuzz/fuzz_input.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const navtwin::fuzz::FuzzFile file(data, size, "kfgins_imu.txt");
+  navtwin::fuzz::ReadOrRefuse([&] { navtwin::fuzz::Drain(*navtwin::OpenKfginsImu(file.path())); });
+  navtwin::fuzz::ReadOrRefuse([&] { navtwin::ReadKfginsImuOdometer(file.path()); });
+  return 0;
+}
