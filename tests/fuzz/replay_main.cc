@@ -1,13 +1,17 @@
 // Replays a fuzz target's inputs without libFuzzer (any compiler): calls the target's
 // LLVMFuzzerTestOneInput on every file of the corpus folder and of the regressions folder.
-//   fuzz_replay_<target> <corpus folder> [<regressions folder>]
-// Fails when the corpus folder holds no input (a replay of nothing would pass unseen); a
-// missing regressions folder is an empty one. A crash or an unexpected exception in the
+//   fuzz_replay_<target> <corpus folder> <regressions folder> [--data=FILE[+TAG]...]
+// --data seeds come from the real records (never copied into the repository): the first
+// 8 KB of $NAVTWIN_DATA/FILE (else the configured ../shared/data), cut at a line end, with
+// the whole of TAG appended when given (rtklib-walk's tag file). A missing data file fails
+// the replay when CI is set, else it is skipped. Fails when no input was replayed at all
+// (a replay of nothing would pass unseen); a missing regressions folder is an empty one. A crash or an unexpected exception in the
 // target ends the program abnormally, which is the finding.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -34,6 +38,50 @@ std::vector<std::uint8_t> Bytes(const std::filesystem::path& file) {
   return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+constexpr std::size_t kDataHead = 8192;
+
+std::filesystem::path DataDir() {
+  const char* env = std::getenv("NAVTWIN_DATA");
+  return env != nullptr && *env != '\0' ? env : NAVTWIN_DEFAULT_DATA_DIR;
+}
+
+/// One --data seed: FILE's head (and TAG whole); false when a file is missing.
+bool DataSeed(const std::string& spec, std::vector<std::uint8_t>* bytes) {
+  const std::size_t plus = spec.find('+');
+  const std::filesystem::path file = DataDir() / spec.substr(0, plus);
+  if (!std::filesystem::is_regular_file(file)) return false;
+  *bytes = Bytes(file);
+  if (bytes->size() > kDataHead) {
+    bytes->resize(kDataHead);
+    while (!bytes->empty() && bytes->back() != '\n') bytes->pop_back();
+  }
+  if (plus == std::string::npos) return true;
+  const std::filesystem::path tag = DataDir() / spec.substr(plus + 1);
+  if (!std::filesystem::is_regular_file(tag)) return false;
+  const std::vector<std::uint8_t> tail = Bytes(tag);
+  bytes->insert(bytes->end(), tail.begin(), tail.end());
+  return true;
+}
+
+/// The --data seeds; -1 when one is missing under CI.
+long ReplayData(const std::vector<std::string>& specs) {
+  long count = 0;
+  for (const std::string& spec : specs) {
+    std::vector<std::uint8_t> bytes;
+    if (!DataSeed(spec, &bytes)) {
+      std::fprintf(stderr, "data seed %s not found under %s%s\n", spec.c_str(), DataDir().string().c_str(),
+                   std::getenv("CI") != nullptr ? "" : " (skipped)");
+      if (std::getenv("CI") != nullptr) return -1;
+      continue;
+    }
+    std::printf("replay data %s\n", spec.c_str());
+    std::fflush(stdout);
+    LLVMFuzzerTestOneInput(bytes.data(), bytes.size());
+    ++count;
+  }
+  return count;
+}
+
 std::size_t Replay(const std::vector<std::filesystem::path>& inputs) {
   for (const auto& input : inputs) {
     std::printf("replay %s\n", input.string().c_str());
@@ -47,16 +95,27 @@ std::size_t Replay(const std::vector<std::filesystem::path>& inputs) {
 }  // namespace replay_main
 
 int main(int argc, char** argv) {
-  if (argc < 2 || argc > 3) {
-    std::fprintf(stderr, "usage: %s <corpus folder> [<regressions folder>]\n", argv[0]);
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: %s <corpus folder> <regressions folder> [--data=FILE[+TAG]...]\n", argv[0]);
     return 2;
   }
+  std::vector<std::string> data;
+  for (int i = 3; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--data=", 0) != 0) {
+      std::fprintf(stderr, "unexpected argument %s\n", argv[i]);
+      return 2;
+    }
+    data.push_back(arg.substr(7));
+  }
   const std::size_t corpus = replay_main::Replay(replay_main::InputsIn(argv[1]));
-  if (corpus == 0) {
-    std::fprintf(stderr, "no input in the corpus folder %s\n", argv[1]);
+  const std::size_t regressions = replay_main::Replay(replay_main::InputsIn(argv[2]));
+  const long seeds = replay_main::ReplayData(data);
+  if (seeds < 0) return 1;
+  if (corpus + static_cast<std::size_t>(seeds) == 0) {
+    std::fprintf(stderr, "no input replayed from %s or the data seeds\n", argv[1]);
     return 1;
   }
-  const std::size_t regressions = argc == 3 ? replay_main::Replay(replay_main::InputsIn(argv[2])) : 0;
-  std::printf("%zu corpus and %zu regression inputs replayed\n", corpus, regressions);
+  std::printf("%zu corpus, %zu regression and %ld data inputs replayed\n", corpus, regressions, seeds);
   return 0;
 }
