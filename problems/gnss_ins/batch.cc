@@ -172,7 +172,7 @@ class BatchSmoother : public ins::BatchAccess {
   // ins::BatchAccess
   std::size_t num_states() const override { return views_.size(); }
   const State& state(std::size_t i) const override { return views_[i]; }
-  const std::vector<ImuSample>& imu() const override { return in_.imu; }
+  const std::vector<ImuSample>& imu() const override { return in_.imu.samples(); }
   const std::vector<std::size_t>& thinned_anchors() const override { return thinned_; }
   double* aux(int i) override { return &aux_[static_cast<std::size_t>(aux_begin_[current_] + i)]; }
   void Add(ceres::CostFunction* cost, bool robust, const std::vector<double*>& blocks,
@@ -360,7 +360,7 @@ std::vector<MeasurementResidual> BatchSmoother::MeasurementResiduals() const {
 /// initial values; the start solution's scale factors where they are not estimated).
 void BatchSmoother::MechanizeAndPreintegrate() {
   const std::vector<NavEpoch>& knots = start_.epochs;
-  const std::vector<ImuSample>& imu = in_.imu;
+  const std::vector<ImuSample>& imu = in_.imu.samples();
   const std::size_t n = states_.size();
   const double t0 = states_.front().t_s;
   const ImuNoise& noise = cfg_.imu_noise;

@@ -1,6 +1,7 @@
 #include "problems/gnss_ins/densify.h"
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "core/imu_split.h"
@@ -90,7 +91,9 @@ void Densify(const Solution& solution, const Inputs& inputs, const std::function
   };
 
   const double t_first = knots[0].state.nav.t_s;
-  for (const ImuSample& s : inputs.imu) {
+  const std::unique_ptr<ImuReader> imu = inputs.imu.Read();
+  ImuSample s;
+  while (imu->Next(&s)) {
     if (s.t_s <= t_first + kTimeTol_s) continue;
     ImuSample piece = s;
     if (piece.t_s - piece.dt_s < t_first - kTimeTol_s) piece = SplitImuSample(piece, t_first).second;

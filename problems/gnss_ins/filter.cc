@@ -246,9 +246,14 @@ class NavigationFilter : public ins::FilterAccess {
     output_(output_epoch_);
   }
 
-  void Progress(std::size_t k, std::size_t n_imu, double t_s) {
+  /// About every 5 % of the record's time span (a streamed record whose end is not known
+  /// yet: of the span up to the last GNSS epoch).
+  void Progress(double t_s) {
     if (progress_ == nullptr) return;
-    const int step = static_cast<int>((k + 1) * 20 / n_imu);
+    const double begin_s = in_.imu.begin_s();
+    const double end_s = in_.imu.end_known() ? in_.imu.back().t_s : in_.gnss.back().t_s;
+    const double fraction = end_s > begin_s ? (t_s - begin_s) / (end_s - begin_s) : 1.0;
+    const int step = static_cast<int>(std::min(20.0, std::floor(20.0 * fraction + 1e-9)));
     if (step <= progress_step_) return;
     progress_step_ = step;
     std::ostringstream line;
@@ -257,7 +262,7 @@ class NavigationFilter : public ins::FilterAccess {
     *progress_ << line.str() << std::flush;
   }
 
-  std::size_t FirstImuSample() const;
+  void FirstImuSample(ImuReader& imu, ImuSample* first) const;
   void ProcessImuSample(const ImuSample& sample, const ImuSample* next, double t0_s);
   FilterResult Result(std::chrono::steady_clock::time_point wall_start);
 
@@ -402,20 +407,18 @@ void NavigationFilter::ResetPositionVelocity(const Eigen::Vector3d& dp_ned_m, co
   Record(key, 0, std::numeric_limits<double>::quiet_NaN(), false);
 }
 
-std::size_t NavigationFilter::FirstImuSample() const {
-  const std::vector<ImuSample>& imu = in_.imu;
+/// The first sample of `imu` ending after the start (the one holding it).
+void NavigationFilter::FirstImuSample(ImuReader& imu, ImuSample* first) const {
   const double t0 = start_.state.nav.t_s;
-  const std::size_t k = std::upper_bound(imu.begin(), imu.end(), t0 + ins::kSameEpoch_s,
-                                         [](double t, const ImuSample& s) { return t < s.t_s; }) -
-                        imu.begin();
-  if (k == imu.size()) {
-    std::ostringstream reason;
-    reason.precision(12);
-    reason << "the filter starts at t = " << t0 << " s, at or after the end of the IMU record (" << imu.back().t_s
-           << " s)";
-    throw InputError(in_.paths.imu, 0, "t", reason.str());
+  double last_t_s = -INFINITY;
+  while (imu.Next(first)) {
+    if (first->t_s > t0 + ins::kSameEpoch_s) return;
+    last_t_s = first->t_s;
   }
-  return k;
+  std::ostringstream reason;
+  reason.precision(12);
+  reason << "the filter starts at t = " << t0 << " s, at or after the end of the IMU record (" << last_t_s << " s)";
+  throw InputError(in_.paths.imu, 0, "t", reason.str());
 }
 
 /// One IMU sample (next: the following one, null at the end): exact-time samples inside it
@@ -454,9 +457,10 @@ void NavigationFilter::ProcessImuSample(const ImuSample& sample, const ImuSample
 
 FilterResult NavigationFilter::Run() {
   const auto wall_start = std::chrono::steady_clock::now();
-  const std::vector<ImuSample>& imu = in_.imu;
   const double t0 = start_.state.nav.t_s;
-  std::size_t k = FirstImuSample();
+  const std::unique_ptr<ImuReader> imu = in_.imu.Read();
+  ImuSample sample, next;
+  FirstImuSample(*imu, &sample);
 
   // Knot 0: the initial state, with the measurements at the start time.
   SkipMeasurementsBeforeStart(t0);
@@ -467,13 +471,14 @@ FilterResult NavigationFilter::Run() {
     StoreKnot(t0, false);
   }
 
-  const std::size_t n_imu = imu.size();
-  double t = t0;
-  for (; k < n_imu; ++k) {
-    ProcessImuSample(imu[k], k + 1 < n_imu ? &imu[k + 1] : nullptr, t0);
-    t = imu[k].t_s;
-    Progress(k, n_imu, t);
+  for (;;) {
+    const bool more = imu->Next(&next);
+    ProcessImuSample(sample, more ? &next : nullptr, t0);
+    Progress(sample.t_s);
+    if (!more) break;
+    sample = next;
   }
+  const double t = sample.t_s;
   FlushGroup();
   if (t > last_knot_t_s_ + ins::kSameEpoch_s) StoreKnot(t, false);
   return Result(wall_start);

@@ -82,9 +82,10 @@ HeadingSearchResult SearchHeading(const Inputs& inputs, const GnssInsConfig& con
   // reaching the window's end (the filter processes a GNSS epoch inside a sample's
   // interval); measurements after t0 only, as the static start skips those at t0 (they
   // made the state).
-  const auto imu_end = std::lower_bound(inputs.imu.begin(), inputs.imu.end(), result.window_end_s - ins::kSameEpoch_s,
+  const std::vector<ImuSample>& head = inputs.imu.Head(result.window_end_s - ins::kSameEpoch_s);
+  const auto imu_end = std::lower_bound(head.begin(), head.end(), result.window_end_s - ins::kSameEpoch_s,
                                         [](const ImuSample& s, double t) { return s.t_s < t; });
-  window.imu.assign(inputs.imu.begin(), imu_end == inputs.imu.end() ? imu_end : imu_end + 1);
+  window.imu = ins::ImuRecord(std::vector<ImuSample>(head.begin(), imu_end == head.end() ? imu_end : imu_end + 1));
   window.gnss = Cut(inputs.gnss, t0, result.window_end_s);
   window.mag = Cut(inputs.mag, t0, result.window_end_s);
   window.baro = Cut(inputs.baro, t0, result.window_end_s);

@@ -47,7 +47,7 @@ bool AnyNonZero(const ImuErrors& e) {
 void PositionFromFirstFix(const Inputs& inputs, const GnssInsConfig& config, FilterStart* start) {
   NavState& nav = start->state.nav;
   const auto fix = std::find_if(inputs.gnss.begin(), inputs.gnss.end(), [&](const GnssSample& g) {
-    return g.t_s >= nav.t_s - ins::kSameEpoch_s && g.t_s < inputs.imu.back().t_s;
+    return g.t_s >= nav.t_s - ins::kSameEpoch_s && g.t_s < inputs.imu.known_end_s();
   });
   if (fix == inputs.gnss.end()) {
     throw InputError(inputs.paths.gnss, 0, "position",
@@ -67,7 +67,7 @@ FilterStart GivenStart(const Inputs& inputs, const GnssInsConfig& config) {
   FilterStart start;
   start.state = *config.init.state;
   if (AnyNonZero(config.init.imu_errors)) start.state.imu = config.init.imu_errors;
-  const double imu_begin_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
+  const double imu_begin_s = inputs.imu.begin_s();
   // A start before the IMU record is taken at its beginning (as KF-GINS does with a
   // starttime before the first IMU sample).
   if (start.state.nav.t_s < imu_begin_s) start.state.nav.t_s = imu_begin_s;
@@ -78,10 +78,10 @@ FilterStart GivenStart(const Inputs& inputs, const GnssInsConfig& config) {
 
 FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& config, std::ostream* progress) {
   const InitConfig& init = config.init;
-  const double begin_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
+  const double begin_s = inputs.imu.begin_s();
   const double end_s = begin_s + init.static_duration_s;
   std::vector<ImuSample> samples;
-  for (const ImuSample& s : inputs.imu) {
+  for (const ImuSample& s : inputs.imu.Head(end_s + ins::kSameEpoch_s)) {
     if (s.t_s > end_s + ins::kSameEpoch_s) break;
     samples.push_back(CorrectImu(s, init.imu_errors));
   }
@@ -148,8 +148,8 @@ FilterStart StaticAlignmentStart(const Inputs& inputs, const GnssInsConfig& conf
 }
 
 FilterStart GnssVelocityStart(const Inputs& inputs, const GnssInsConfig& config) {
-  const double imu_begin_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
-  const double imu_end_s = inputs.imu.back().t_s;
+  const double imu_begin_s = inputs.imu.begin_s();
+  const double imu_end_s = inputs.imu.known_end_s();  // +infinity before a streamed record's first pass
   for (const GnssSample& fix : inputs.gnss) {
     if (fix.t_s < imu_begin_s || fix.t_s >= imu_end_s) continue;
     if (!fix.has_velocity || fix.v_n_mps.head<2>().norm() < config.init.min_speed_mps) continue;

@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "core/calibration_file.h"
@@ -75,33 +78,72 @@ RunCalibration ReadRunCalibration(const InputPaths& paths, const Installation& c
   return c;
 }
 
-std::vector<ImuSample> ReadImu(const std::string& path, const RunCalibration& calibration, double temperature_degC,
-                               const GnssInsConfig& config) {
-  const Installation& inst = calibration.installation;
-  const Eigen::Vector3d& rpy = inst.imu_mounting_rpy_rad;
-  // v_b = R_b_imu v_imu (config.h, Installation).
-  const Eigen::Matrix3d R_b_imu = DcmFromEuler(rpy[0], rpy[1], rpy[2]);
-  auto reader = OpenImu(path);
-  if (calibration.imu) reader = CalibratedImuReader(std::move(reader), *calibration.imu, temperature_degC);
-  std::vector<ImuSample> out;
-  ImuSample s;
-  while (reader->Next(&s)) {
-    RequireFinite(std::isfinite(s.t_s) && std::isfinite(s.dt_s), path, "time", s.t_s);
-    RequireFinite(s.dtheta_b_rad.allFinite(), path, "dtheta", s.t_s);
-    RequireFinite(s.dv_b_mps.allFinite(), path, "dv", s.t_s);
-    s.t_s += inst.imu_time_offset_s;
-    if (s.t_s - s.dt_s < config.start_time_s - ins::kSameEpoch_s) continue;
-    if (s.t_s > config.end_time_s + ins::kSameEpoch_s) break;
-    s.dtheta_b_rad = R_b_imu * s.dtheta_b_rad;
-    s.dv_b_mps = R_b_imu * s.dv_b_mps;
-    out.push_back(s);
+/// The IMU samples of a reader in the run's terms: finite, on the GNSS time scale (the
+/// installation's time offset added), inside [start_time_s, end_time_s] (the sample holding
+/// the start included), in the body axes (the mounting applied).
+class InstalledImuReader final : public ImuReader {
+ public:
+  InstalledImuReader(std::unique_ptr<ImuReader> reader, const Installation& installation, const GnssInsConfig& config)
+      : reader_(std::move(reader)),
+        // v_b = R_b_imu v_imu (config.h, Installation).
+        R_b_imu_(DcmFromEuler(installation.imu_mounting_rpy_rad[0], installation.imu_mounting_rpy_rad[1],
+                              installation.imu_mounting_rpy_rad[2])),
+        time_offset_s_(installation.imu_time_offset_s),
+        start_s_(config.start_time_s),
+        end_s_(config.end_time_s) {}
+
+  bool Next(ImuSample* out) override {
+    ImuSample s;
+    while (!ended_ && reader_->Next(&s)) {
+      const std::string& file = reader_->path();
+      RequireFinite(std::isfinite(s.t_s) && std::isfinite(s.dt_s), file, "time", s.t_s);
+      RequireFinite(s.dtheta_b_rad.allFinite(), file, "dtheta", s.t_s);
+      RequireFinite(s.dv_b_mps.allFinite(), file, "dv", s.t_s);
+      s.t_s += time_offset_s_;
+      if (s.t_s - s.dt_s < start_s_ - ins::kSameEpoch_s) continue;
+      if (s.t_s > end_s_ + ins::kSameEpoch_s) break;
+      s.dtheta_b_rad = R_b_imu_ * s.dtheta_b_rad;
+      s.dv_b_mps = R_b_imu_ * s.dv_b_mps;
+      *out = s;
+      return true;
+    }
+    ended_ = true;  // the rest of the file lies after end_time_s
+    return false;
   }
-  if (out.size() < 2) {
+  const std::string& path() const override { return reader_->path(); }
+
+ private:
+  std::unique_ptr<ImuReader> reader_;
+  Eigen::Matrix3d R_b_imu_;
+  double time_offset_s_, start_s_, end_s_;
+  bool ended_ = false;
+};
+
+/// The IMU record: the file (any format), its calibration, the installation, the span,
+/// the gaps bridged; in memory or streamed. Fewer than two samples in the span is an
+/// InputError.
+ins::ImuRecord ReadImu(const std::string& path, const RunCalibration& calibration, double temperature_degC,
+                       const GnssInsConfig& config, ImuStorage storage) {
+  const ins::ImuRecord::Opener open = [=](std::size_t* bridged) {
+    auto reader = OpenImu(path);
+    if (calibration.imu) reader = CalibratedImuReader(std::move(reader), *calibration.imu, temperature_degC);
+    reader = std::make_unique<InstalledImuReader>(std::move(reader), calibration.installation, config);
+    return ins::GapBridgingImuReader(std::move(reader), config.filter.max_bridge_gap_s, "filter.max_bridge_gap_s",
+                                     calibration.installation.imu_time_offset_s, bridged);
+  };
+  ins::ImuRecord record = ins::ImuRecord::Streamed(open);
+  if (storage == ImuStorage::kInMemory) {
+    std::size_t bridged = 0;
+    std::vector<ImuSample> samples = ReadAll(*open(&bridged));
+    record = ins::ImuRecord(std::move(samples), bridged);
+  }
+  const std::vector<ImuSample>& head = record.Head(-std::numeric_limits<double>::infinity());
+  if (head.empty() || record.Head(head.front().t_s + ins::kSameEpoch_s).size() < 2) {
     throw InputError(path, 0, "time",
                      "fewer than 2 IMU samples inside the configured span [" +
                          Num(config.start_time_s) + ", " + Num(config.end_time_s) + "] s");
   }
-  return out;
+  return record;
 }
 
 std::vector<GnssSample> ReadGnss(const std::string& path, double t_begin, double t_end) {
@@ -191,9 +233,50 @@ std::vector<BaroSample> ReadBaro(const std::string& path, double t_begin, double
   return out;
 }
 
+/// Injected outages: [t_begin + start + k period, ... + len), k = 0, 1, ..., up to the last
+/// GNSS epoch; the epochs inside them move from in->gnss to in->gnss_removed.
+void InjectOutages(const OutageConfig& o, double t_begin, Inputs* in) {
+  if (std::isnan(o.start_s)) return;
+  if (!(o.len_s > 0.0) || o.start_s < 0.0 || o.period_s < 0.0 || (o.period_s > 0.0 && o.period_s <= o.len_s)) {
+    throw std::invalid_argument("outages: need start_s >= 0, len_s > 0 and period_s 0 or > len_s");
+  }
+  const double last_gnss_s = in->gnss.back().t_s;
+  for (double a = t_begin + o.start_s; a <= last_gnss_s; a += o.period_s) {
+    in->outages.emplace_back(a, a + o.len_s);
+    if (o.period_s <= 0.0) break;
+  }
+  std::vector<GnssSample> kept;
+  kept.reserve(in->gnss.size());
+  std::size_t k = 0;
+  for (const GnssSample& g : in->gnss) {
+    while (k < in->outages.size() && g.t_s >= in->outages[k].second) ++k;
+    if (k < in->outages.size() && g.t_s >= in->outages[k].first) {
+      ++in->gnss_removed_by_outages;
+      in->gnss_removed.push_back(g);
+    } else {
+      kept.push_back(g);
+    }
+  }
+  in->gnss = std::move(kept);
+  if (in->gnss.empty()) throw InputError(in->paths.gnss, 0, "time", "the injected outages remove every GNSS epoch");
+}
+
+/// The samples of `v` up to t_end_s (a record's samples are in time order).
+template <typename Sample>
+void CutAfter(double t_end_s, std::vector<Sample>* v) {
+  const auto after = std::upper_bound(v->begin(), v->end(), t_end_s + ins::kSameEpoch_s,
+                                      [](double t, const Sample& x) { return t < x.t_s; });
+  v->erase(after, v->end());
+}
+
+std::string NoGnssInSpan(double t_begin, double t_end) {
+  return "no GNSS epoch inside the IMU span [" + Num(t_begin) + ", " + Num(t_end) +
+         "] s (check the time scales: GPS seconds of week vs. relative time, installation.imu_time_offset_s)";
+}
+
 }  // namespace
 
-Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
+Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config, ImuStorage storage) {
   if (paths.imu.empty()) throw InputError("(no file)", 0, "imu", "no IMU file given");
   if (paths.gnss.empty()) throw InputError("(no file)", 0, "gnss", "no GNSS file given");
   // The calibration file's sections that apply (an empty path: none).
@@ -202,55 +285,39 @@ Inputs LoadInputs(const InputPaths& paths, const GnssInsConfig& config) {
   in.paths = paths;
   in.installation = calibration.installation;
   in.installation_from_calibration = calibration.installation_from_file;
-  in.imu = ins::BridgeGaps(ReadImu(paths.imu, calibration, paths.imu_temperature_degC, config), paths.imu,
-                           calibration.installation.imu_time_offset_s, config.filter.max_bridge_gap_s,
-                           "filter.max_bridge_gap_s", &in.bridged_imu_gaps);
-  const double t_begin = in.imu.front().t_s - in.imu.front().dt_s;
-  const double t_end = in.imu.back().t_s;
+  in.imu = ReadImu(paths.imu, calibration, paths.imu_temperature_degC, config, storage);
+  const double t_begin = in.imu.begin_s();
+  const double t_end = in.imu.known_end_s();  // +infinity for a streamed record
 
   in.gnss = ReadGnss(paths.gnss, t_begin, t_end);
-  if (in.gnss.empty()) {
-    throw InputError(paths.gnss, 0, "time",
-                     "no GNSS epoch inside the IMU span [" + Num(t_begin) + ", " + Num(t_end) +
-                         "] s (check the time scales: GPS seconds of week vs. relative time, "
-                         "installation.imu_time_offset_s)");
-  }
-
-  // Injected outages: [t_begin + start + k period, ... + len), k = 0, 1, ... .
-  const OutageConfig& o = config.outages;
-  if (!std::isnan(o.start_s)) {
-    if (!(o.len_s > 0.0) || o.start_s < 0.0 || o.period_s < 0.0 ||
-        (o.period_s > 0.0 && o.period_s <= o.len_s)) {
-      throw std::invalid_argument("outages: need start_s >= 0, len_s > 0 and period_s 0 or > len_s");
-    }
-    for (double a = t_begin + o.start_s; a < t_end; a += o.period_s) {
-      in.outages.emplace_back(a, a + o.len_s);
-      if (o.period_s <= 0.0) break;
-    }
-    std::vector<GnssSample> kept;
-    kept.reserve(in.gnss.size());
-    std::size_t k = 0;
-    for (const GnssSample& g : in.gnss) {
-      while (k < in.outages.size() && g.t_s >= in.outages[k].second) ++k;
-      if (k < in.outages.size() && g.t_s >= in.outages[k].first) {
-        ++in.gnss_removed_by_outages;
-        in.gnss_removed.push_back(g);
-      } else {
-        kept.push_back(g);
-      }
-    }
-    in.gnss = std::move(kept);
-    if (in.gnss.empty()) {
-      throw InputError(paths.gnss, 0, "time", "the injected outages remove every GNSS epoch");
-    }
-  }
-
+  if (in.gnss.empty()) throw InputError(paths.gnss, 0, "time", NoGnssInSpan(t_begin, t_end));
+  InjectOutages(config.outages, t_begin, &in);
   if (!paths.mag.empty()) in.mag = ReadMag(paths.mag, calibration.mag, t_begin, t_end);
   if (!paths.baro.empty()) in.baro = ReadBaro(paths.baro, t_begin, t_end);
   if (config.odometer.enabled()) {
-    in.odometer = ReadOdometerSpan(config.odometer.from_imu_file ? paths.imu : config.odometer.file, t_begin, t_end);
+    in.odometer_file = config.odometer.from_imu_file ? paths.imu : config.odometer.file;
+    in.odometer = ReadOdometerSpan(in.odometer_file, t_begin, t_end);
   }
+  if (in.imu.end_known()) CutToImuEnd(&in);
   return in;
+}
+
+void CutToImuEnd(Inputs* in) {
+  const double t_end = in->imu.back().t_s;
+  CutAfter(t_end, &in->gnss);
+  if (in->gnss.empty()) throw InputError(in->paths.gnss, 0, "time", NoGnssInSpan(in->imu.begin_s(), t_end));
+  CutAfter(t_end, &in->gnss_removed);
+  in->gnss_removed_by_outages = in->gnss_removed.size();
+  while (!in->outages.empty() && in->outages.back().first >= t_end) in->outages.pop_back();
+  CutAfter(t_end, &in->mag);
+  CutAfter(t_end, &in->baro);
+  if (!in->odometer.empty()) {
+    CutAfter(t_end, &in->odometer);
+    if (in->odometer.empty()) {
+      throw InputError(in->odometer_file, 0, "t", "no odometer sample inside the IMU record [" +
+                                                     Num(in->imu.begin_s()) + ", " + Num(t_end) + "] s");
+    }
+  }
 }
 
 }  // namespace navtwin::gnss_ins

@@ -156,8 +156,7 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
 /// IMU interval (after the installation's time offset); the IMU-error estimates and the
 /// stds stay the configuration's.
 void InitFromNavFile(const Inputs& inputs, GnssInsConfig* config) {
-  const double imu_start_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
-  const double t_s = std::isfinite(config->start_time_s) ? config->start_time_s : imu_start_s;
+  const double t_s = std::isfinite(config->start_time_s) ? config->start_time_s : inputs.imu.begin_s();
   const std::unique_ptr<NavReader> reader = OpenNav(config->init.nav_file_at_start);
   InsState state;
   state.nav = InitialStateFromNav(*reader, t_s);
@@ -175,10 +174,10 @@ InputSummary SummarizeInputs(const Inputs& inputs) {
   s.gnss_epochs = inputs.gnss.size();
   s.mag_samples = inputs.mag.size();
   s.baro_samples = inputs.baro.size();
-  s.bridged_imu_gaps = inputs.bridged_imu_gaps;
+  s.bridged_imu_gaps = inputs.imu.bridged_gaps();
   s.gnss_removed_by_outages = inputs.gnss_removed_by_outages;
   if (!inputs.imu.empty()) {
-    s.t_start_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
+    s.t_start_s = inputs.imu.begin_s();
     s.t_end_s = inputs.imu.back().t_s;
   }
   s.outages = inputs.outages;
@@ -192,7 +191,8 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
     *options.progress << options.command << ": reading " << p.imu << ", " << p.gnss
                       << (p.mag.empty() ? "" : ", " + p.mag) << (p.baro.empty() ? "" : ", " + p.baro) << "\n";
   }
-  const Inputs inputs = LoadInputs(p, config);
+  // The batch needs the IMU record in memory; the filter and RTS read it in passes.
+  Inputs inputs = LoadInputs(p, config, options.methods == RunMethods::kAll ? ImuStorage::kInMemory : ImuStorage::kStreamed);
   if (inputs.installation_from_calibration && options.progress) {
     const Eigen::Vector3d rpy_deg = inputs.installation.imu_mounting_rpy_rad * kRadToDeg;
     char line[256];
@@ -201,21 +201,20 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
     *options.progress << options.command << line;
   }
   if (!config.init.nav_file_at_start.empty()) InitFromNavFile(inputs, &config);
-  if (config.init.state && std::isnan(config.init.state->nav.t_s)) {
-    config.init.state->nav.t_s = inputs.imu.front().t_s - inputs.imu.front().dt_s;
-  }
-  if (inputs.bridged_imu_gaps > 0 && options.progress) {
-    *options.progress << options.command << ": bridged " << inputs.bridged_imu_gaps << " short IMU gap(s)\n";
-  }
+  if (config.init.state && std::isnan(config.init.state->nav.t_s)) config.init.state->nav.t_s = inputs.imu.begin_s();
   GnssInsRun run;
-  run.inputs = SummarizeInputs(inputs);
   run.output_rate_hz = config.output_rate_hz;
   run.prior_std = InitialStdVector(config, config.filter.scale_factors ? ins::err::kSize21 : ins::err::kSize15);
-  AtomicFile gnss_csv(options.out_dir + "/gnss.csv");
-  WriteGnssCsv(gnss_csv.stream(), inputs.gnss, inputs.gnss_removed);
   NavOutputWriter writer(options.out_dir, config.filter.scale_factors);
   MethodFiles method_files;
   RunEstimators(RunSinks{options, config, inputs, &writer, &method_files}, &run);
+  if (inputs.imu.streamed()) CutToImuEnd(&inputs);  // the filter's pass found the IMU record's end
+  if (inputs.imu.bridged_gaps() > 0 && options.progress) {
+    *options.progress << options.command << ": bridged " << inputs.imu.bridged_gaps() << " short IMU gap(s)\n";
+  }
+  run.inputs = SummarizeInputs(inputs);
+  AtomicFile gnss_csv(options.out_dir + "/gnss.csv");
+  WriteGnssCsv(gnss_csv.stream(), inputs.gnss, inputs.gnss_removed);
   run.output_epochs = writer.count();
   if (run.output_epochs == 0) throw std::runtime_error("the run produced no output epoch");
   run.warnings = Diagnose(run);

@@ -20,8 +20,13 @@ std::string Num(double x) {
 /// Streams the samples of another reader through an ImuGapBridge.
 class GapBridgingReader final : public ImuReader {
  public:
-  GapBridgingReader(std::unique_ptr<ImuReader> reader, double max_gap_s, std::string limit_name)
-      : reader_(std::move(reader)), max_gap_s_(max_gap_s), limit_name_(std::move(limit_name)) {}
+  GapBridgingReader(std::unique_ptr<ImuReader> reader, double max_gap_s, std::string limit_name,
+                    double time_offset_s, std::size_t* bridged)
+      : reader_(std::move(reader)),
+        max_gap_s_(max_gap_s),
+        limit_name_(std::move(limit_name)),
+        time_offset_s_(time_offset_s),
+        bridged_(bridged) {}
 
   bool Next(ImuSample* sample) override {
     if (!bridge_) Start();
@@ -31,6 +36,7 @@ class GapBridgingReader final : public ImuReader {
       ImuSample s;
       if (!reader_->Next(&s)) return false;
       bridge_->Add(s, &ready_);
+      if (bridged_) *bridged_ = bridge_->bridged();
     }
     *sample = ready_[next_++];
     return true;
@@ -44,13 +50,16 @@ class GapBridgingReader final : public ImuReader {
     ImuSample s;
     while (head.size() < kGapLookahead && reader_->Next(&s)) head.push_back(s);
     const double nominal = head.empty() ? 0.0 : MedianInterval(head);
-    bridge_ = std::make_unique<ImuGapBridge>(reader_->path(), nominal, max_gap_s_, 0.0, limit_name_);
+    bridge_ = std::make_unique<ImuGapBridge>(reader_->path(), nominal, max_gap_s_, time_offset_s_, limit_name_);
     for (const ImuSample& h : head) bridge_->Add(h, &ready_);
+    if (bridged_) *bridged_ = bridge_->bridged();
   }
 
   std::unique_ptr<ImuReader> reader_;
   double max_gap_s_;
   std::string limit_name_;
+  double time_offset_s_;
+  std::size_t* bridged_;
   std::unique_ptr<ImuGapBridge> bridge_;
   std::vector<ImuSample> ready_;
   std::size_t next_ = 0;
@@ -99,20 +108,10 @@ void ImuGapBridge::Add(const ImuSample& s, std::vector<ImuSample>* out) {
   ++bridged_;
 }
 
-std::vector<ImuSample> BridgeGaps(const std::vector<ImuSample>& imu, const std::string& path,
-                                  double time_offset_s, double max_gap_s, const std::string& limit_name,
-                                  std::size_t* bridged) {
-  ImuGapBridge bridge(path, MedianInterval(imu), max_gap_s, time_offset_s, limit_name);
-  std::vector<ImuSample> out;
-  out.reserve(imu.size());
-  for (const ImuSample& s : imu) bridge.Add(s, &out);
-  *bridged += bridge.bridged();
-  return out;
-}
-
 std::unique_ptr<ImuReader> GapBridgingImuReader(std::unique_ptr<ImuReader> reader, double max_gap_s,
-                                                const std::string& limit_name) {
-  return std::make_unique<GapBridgingReader>(std::move(reader), max_gap_s, limit_name);
+                                                const std::string& limit_name, double time_offset_s,
+                                                std::size_t* bridged) {
+  return std::make_unique<GapBridgingReader>(std::move(reader), max_gap_s, limit_name, time_offset_s, bridged);
 }
 
 }  // namespace navtwin::ins

@@ -45,16 +45,13 @@ class ImuGapBridge {
   std::size_t bridged_ = 0;
 };
 
-/// The whole record with its gaps bridged (nominal interval: MedianInterval); adds the
-/// number of gaps bridged to *bridged. `limit_name` as for ImuGapBridge.
-std::vector<ImuSample> BridgeGaps(const std::vector<ImuSample>& imu, const std::string& path,
-                                  double time_offset_s, double max_gap_s, const std::string& limit_name,
-                                  std::size_t* bridged);
-
-/// A reader that bridges the gaps of `reader` while streaming (records too long to hold in
-/// memory): the nominal interval is the median of the first kGapLookahead samples.
+/// A reader that bridges the gaps of `reader` while streaming: the nominal interval is the
+/// median of the first kGapLookahead samples. `time_offset_s`: what was added to the file's
+/// time tags (messages give file time). When `bridged` is not null, *bridged holds the
+/// number of gaps bridged so far.
 constexpr std::size_t kGapLookahead = 1000;
 std::unique_ptr<ImuReader> GapBridgingImuReader(std::unique_ptr<ImuReader> reader, double max_gap_s,
-                                                const std::string& limit_name);
+                                                const std::string& limit_name, double time_offset_s = 0.0,
+                                                std::size_t* bridged = nullptr);
 
 }  // namespace navtwin::ins

@@ -81,7 +81,7 @@ TEST(LoadInputs, AppliesMountingAndTimeOffset) {
   ASSERT_EQ(in.gnss.size(), 5u);
   EXPECT_EQ(in.gnss.front().t_s, 0.5);
   EXPECT_EQ(in.gnss.back().t_s, 2.5);
-  EXPECT_EQ(in.bridged_imu_gaps, 0u);
+  EXPECT_EQ(in.imu.bridged_gaps(), 0u);
 }
 
 TEST(LoadInputs, CutsToStartAndEnd) {
@@ -105,7 +105,7 @@ TEST(LoadInputs, BridgesShortImuGaps) {
   GnssInsConfig c;
   c.filter.max_bridge_gap_s = 0.05;
   const Inputs in = LoadInputs(f.paths, c);
-  EXPECT_EQ(in.bridged_imu_gaps, 1u);
+  EXPECT_EQ(in.imu.bridged_gaps(), 1u);
   ASSERT_EQ(in.imu.size(), 200u);
   for (std::size_t k = 0; k < in.imu.size(); ++k) {
     EXPECT_NEAR(in.imu[k].dt_s, 0.01, 1e-12) << k;

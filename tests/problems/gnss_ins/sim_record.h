@@ -53,7 +53,7 @@ inline SimRecord SimulateRecord(const sim::Scenario& scenario, std::uint64_t see
   sim::Simulate(scenario, options, dir);
   SimRecord r;
   r.inputs.paths.imu = dir + "/imu.txt";
-  r.inputs.imu = ReadAll<ImuSample>(OpenImu(r.inputs.paths.imu));
+  r.inputs.imu = ins::ImuRecord(ReadAll<ImuSample>(OpenImu(r.inputs.paths.imu)));
   if (scenario.gnss) {
     r.inputs.paths.gnss = dir + "/gnss.txt";
     r.inputs.gnss = ReadAll<GnssSample>(OpenGnss(r.inputs.paths.gnss));
