@@ -78,6 +78,8 @@ class ImuPreintegration {
   double t_start_s() const;
   double t_end_s() const;
   std::size_t num_samples() const { return samples_.size(); }
+  /// Releases the spare capacity of the stored samples (when no more samples follow).
+  void ShrinkToFit() { samples_.shrink_to_fit(); }
   const std::vector<ImuSample>& samples() const { return samples_; }
 
   /// Preintegrated rotation R_bi_bj (as a matrix and as a unit quaternion), velocity and

@@ -1,12 +1,14 @@
 // GNSS/INS estimator benchmark on the nav-grade-vehicle-1h preset (200 Hz IMU, 1 Hz RTK
 // GNSS, one hour of driving), simulated once into a temporary folder:
-//   Filter/output_hz:10   the error-state filter over the hour, navigation output at 10 Hz
+//   Filter/output_hz:10   the error-state filter over the hour reading the IMU file as it goes
+//                         (as `navigate` does), navigation output at 10 Hz
 //                         written to nav.nav, nav.csv, std.csv and imu_errors.csv (the
 //                         last two at std_rate_hz, 1 Hz, as `navigate` writes them)
 //   Filter/output_hz:0    the same with output at every IMU epoch (200 Hz)
 //   Batch/minutes:N       the full-batch Ceres smoother (started from the filter, with the
-//                         per-state covariance) over the first N = 15, 30, 60 minutes;
-//                         the filter run that starts it is not timed
+//                         per-state covariance) over the first N = 15, 30, 60 minutes,
+//                         reading the IMU file in a pass (as `smooth` does); the filter run
+//                         that starts it is not timed
 //   ParseImu, FilterOnly, WriteEveryEpoch   the stages of `navtwin navigate` apart (below)
 // Each case reports peak_rss_MB, the process's peak resident memory after the case: run one
 // case per process for per-case figures, e.g.
@@ -101,7 +103,7 @@ void BM_Filter(benchmark::State& state) {
   const NavGradeHour& hour = NavGradeHour::Get();
   GnssInsConfig config = hour.Config(60.0);
   config.output_rate_hz = static_cast<double>(state.range(0));
-  const Inputs inputs = LoadInputs(Paths(hour), config);
+  const Inputs inputs = LoadInputs(Paths(hour), config, ImuStorage::kStreamed);
   const std::string out_dir = hour.dir() + "/filter_out";
   std::filesystem::create_directories(out_dir);
   std::size_t outputs = 0;
@@ -189,7 +191,7 @@ BENCHMARK(BM_WriteEveryEpoch)->Unit(benchmark::kSecond)->Iterations(1);
 void BM_Batch(benchmark::State& state) {
   const NavGradeHour& hour = NavGradeHour::Get();
   const GnssInsConfig config = hour.Config(static_cast<double>(state.range(0)));
-  const Inputs inputs = LoadInputs(Paths(hour), config);
+  const Inputs inputs = LoadInputs(Paths(hour), config, ImuStorage::kStreamed);
   const FilterResult start = RunFilter(inputs, config, /*run_rts=*/false, {}, nullptr);
   std::size_t states = 0;
   for (auto _ : state) {

@@ -34,6 +34,7 @@
 #include "factors/state_prior.h"
 #include "problems/gnss_ins/batch_plan.h"
 #include "problems/gnss_ins/initial_state.h"
+#include "problems/ins/association.h"
 #include "problems/gnss_ins/sources.h"
 #include "problems/ins/measurement_rules.h"
 #include "solvers/batch_driver.h"
@@ -172,7 +173,7 @@ class BatchSmoother : public ins::BatchAccess {
   // ins::BatchAccess
   std::size_t num_states() const override { return views_.size(); }
   const State& state(std::size_t i) const override { return views_[i]; }
-  const std::vector<ImuSample>& imu() const override { return in_.imu.samples(); }
+  Eigen::Quaterniond BodyRotation(double a_s, double b_s, const ImuErrors& errors) const override;
   const std::vector<std::size_t>& thinned_anchors() const override { return thinned_; }
   double* aux(int i) override { return &aux_[static_cast<std::size_t>(aux_begin_[current_] + i)]; }
   void Add(ceres::CostFunction* cost, bool robust, const std::vector<double*>& blocks,
@@ -230,6 +231,9 @@ class BatchSmoother : public ins::BatchAccess {
   std::array<std::array<double, 3>, kImuErrorKinds> shared_imu_{};
   std::vector<BatchState> states_;
   std::vector<std::shared_ptr<ImuPreintegration>> pre_;  ///< interval i: states i -> i + 1
+  /// The IMU samples (and the piece of the one holding t0) in the kMaxSensorAssociation_s
+  /// before the first state: with the preintegrated pieces, the increments BodyRotation needs.
+  std::vector<ImuSample> before_start_;
   std::vector<ceres::ResidualBlockId> imu_factors_;
   std::map<std::string, MeasurementCount> counts_;
   /// A source's residual block (BatchAccess::Add): its count key and the time of its state.
@@ -360,7 +364,6 @@ std::vector<MeasurementResidual> BatchSmoother::MeasurementResiduals() const {
 /// initial values; the start solution's scale factors where they are not estimated).
 void BatchSmoother::MechanizeAndPreintegrate() {
   const std::vector<NavEpoch>& knots = start_.epochs;
-  const std::vector<ImuSample>& imu = in_.imu.samples();
   const std::size_t n = states_.size();
   const double t0 = states_.front().t_s;
   const ImuNoise& noise = cfg_.imu_noise;
@@ -422,19 +425,30 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   };
 
   pre_.assign(n > 0 ? n - 1 : 0, nullptr);
-  // The angular rate at t0: of the sample that ends at or contains t0.
-  auto k = std::lower_bound(imu.begin(), imu.end(), t0 - ins::kSameEpoch_s,
-                            [](const ImuSample& s, double t) { return s.t_s < t; });
-  if (k != imu.end()) omega = CorrectImu(*k, errors).dtheta_b_rad / k->dt_s;
-  // Samples ending at or before t0 only feed the stillness window.
-  for (auto w = imu.begin(); w != imu.end() && w->t_s <= t0 + ins::kSameEpoch_s; ++w) {
-    if (detector && w->t_s > t0 - still_rule->window_s - 1.0) detector->Add(CorrectImu(*w, errors));
+  // One pass over the IMU record. Samples ending at or before t0 only feed the stillness
+  // window (and are kept for BodyRotation when close to t0); the angular rate at t0 is the
+  // one of the sample that ends at or contains t0.
+  const std::unique_ptr<ImuReader> reader = in_.imu.Read();
+  ImuSample sample;
+  bool have = false, omega_set = false;
+  while (reader->Next(&sample)) {
+    if (!omega_set && sample.t_s >= t0 - ins::kSameEpoch_s) {
+      omega = CorrectImu(sample, errors).dtheta_b_rad / sample.dt_s;
+      omega_set = true;
+    }
+    if (sample.t_s > t0 + ins::kSameEpoch_s) {
+      have = true;
+      break;
+    }
+    if (detector && sample.t_s > t0 - still_rule->window_s - 1.0) detector->Add(CorrectImu(sample, errors));
+    if (sample.t_s > t0 - ins::kMaxSensorAssociation_s - 1.0) before_start_.push_back(sample);
+  }
+  if (have && sample.t_s - sample.dt_s < t0 - ins::kSameEpoch_s) {
+    before_start_.push_back(SplitImuSample(sample, t0).first);
   }
   record_state();
-  k = std::upper_bound(imu.begin(), imu.end(), t0 + ins::kSameEpoch_s,
-                       [](double t, const ImuSample& s) { return t < s.t_s; });
-  for (; k != imu.end() && si < n; ++k) {
-    ImuSample piece = *k;
+  for (; have && si < n; have = reader->Next(&sample)) {
+    ImuSample piece = sample;
     if (piece.t_s - piece.dt_s < t0 - ins::kSameEpoch_s) piece = SplitImuSample(piece, t0).second;
     while (true) {
       const double next_knot = kn < knots.size() ? knots[kn].state.nav.t_s : INFINITY;
@@ -450,9 +464,10 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     }
     if (si >= n) break;
     step(piece);
-    if (detector) detector->Add(CorrectImu(*k, errors));
+    if (detector) detector->Add(CorrectImu(sample, errors));
     events(piece.t_s);
   }
+  for (const std::shared_ptr<ImuPreintegration>& pre : pre_) pre->ShrinkToFit();
   if (si < n) {
     std::ostringstream text;
     text.precision(12);
@@ -561,6 +576,21 @@ void BatchSmoother::AddAuxPriors() {
       problem_->SetParameterBlockConstant(block);
     }
   }
+}
+
+/// ins::BodyRotation over the pieces of the intervals overlapping [a_s, b_s] (and the
+/// samples before the first state).
+Eigen::Quaterniond BatchSmoother::BodyRotation(double a_s, double b_s, const ImuErrors& errors) const {
+  std::vector<ImuSample> pieces;
+  if (a_s < states_.front().t_s) pieces = before_start_;
+  const auto first = std::upper_bound(states_.begin(), states_.end(), a_s,
+                                      [](double t, const BatchState& s) { return t < s.t_s; });
+  std::size_t i = first == states_.begin() ? 0 : static_cast<std::size_t>(first - states_.begin()) - 1;
+  for (; i < pre_.size() && states_[i].t_s < b_s; ++i) {
+    const std::vector<ImuSample>& p = pre_[i]->samples();
+    pieces.insert(pieces.end(), p.begin(), p.end());
+  }
+  return ins::BodyRotation(pieces, a_s, b_s, errors);
 }
 
 /// Reintegrates the intervals whose gyro bias (or gyro scale factor) moved too far from the

@@ -251,7 +251,7 @@ class NavigationFilter : public ins::FilterAccess {
   void Progress(double t_s) {
     if (progress_ == nullptr) return;
     const double begin_s = in_.imu.begin_s();
-    const double end_s = in_.imu.end_known() ? in_.imu.back().t_s : in_.gnss.back().t_s;
+    const double end_s = in_.imu.end_known() ? in_.imu.back().t_s : in_.gnss.empty() ? t_s : in_.gnss.back().t_s;
     const double fraction = end_s > begin_s ? (t_s - begin_s) / (end_s - begin_s) : 1.0;
     const int step = static_cast<int>(std::min(20.0, std::floor(20.0 * fraction + 1e-9)));
     if (step <= progress_step_) return;

@@ -191,8 +191,8 @@ GnssInsRun RunGnssIns(const RunOptions& options, GnssInsConfig config) {
     *options.progress << options.command << ": reading " << p.imu << ", " << p.gnss
                       << (p.mag.empty() ? "" : ", " + p.mag) << (p.baro.empty() ? "" : ", " + p.baro) << "\n";
   }
-  // The batch needs the IMU record in memory; the filter and RTS read it in passes.
-  Inputs inputs = LoadInputs(p, config, options.methods == RunMethods::kAll ? ImuStorage::kInMemory : ImuStorage::kStreamed);
+  // Every estimator reads the IMU record in passes (the batch keeps its preintegrated pieces).
+  Inputs inputs = LoadInputs(p, config, ImuStorage::kStreamed);
   if (inputs.installation_from_calibration && options.progress) {
     const Eigen::Vector3d rpy_deg = inputs.installation.imu_mounting_rpy_rad * kRadToDeg;
     char line[256];

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "core/types.h"
 #include "problems/ins/ins_state.h"
@@ -108,8 +109,10 @@ class BatchAccess {
   virtual ~BatchAccess() = default;
   virtual std::size_t num_states() const = 0;
   virtual const State& state(std::size_t i) const = 0;
-  /// The IMU record (body axes), for sources that carry a sample to a state's time.
-  virtual const std::vector<ImuSample>& imu() const = 0;
+  /// The body rotation from t = a_s to t = b_s (a_s <= b_s, inside the states' span) by
+  /// BodyRotation over the IMU increments corrected with `errors`, for sources that carry
+  /// a sample to a state's time.
+  virtual Eigen::Quaterniond BodyRotation(double a_s, double b_s, const ImuErrors& errors) const = 0;
   /// The anchoring source's samples in the span that got no state (state_interval_s).
   virtual const std::vector<std::size_t>& thinned_anchors() const = 0;
   /// The parameter block (1 double) of the source's auxiliary state i.
@@ -174,5 +177,10 @@ inline const StillnessConfig* StillnessRule(const AidingSources& sources) {
   return nullptr;
 }
 
+/// R_{b(a) b(b)} for a <= b: the body rotation over [a, b] as the product of Exp of the
+/// bias-corrected gyro increments (pieces of samples pro rata), v_{b(a)} = R v_{b(b)}. The
+/// rotation of the navigation frame over |b - a| <= kMaxSensorAssociation_s (< 4e-5 rad)
+/// is left out.
+Eigen::Quaterniond BodyRotation(const std::vector<ImuSample>& imu, double a, double b, const ImuErrors& e);
 
 }  // namespace navtwin::ins

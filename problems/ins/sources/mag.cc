@@ -1,5 +1,6 @@
 #include "problems/ins/sources/mag.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -11,14 +12,7 @@
 #include "problems/ins/association.h"
 
 namespace navtwin::ins {
-namespace {
 
-const char* const kMag = "mag";
-
-/// R_{b(a) b(b)} for a <= b: the body rotation over [a, b] as the product of Exp of the
-/// bias-corrected gyro increments (pieces of samples pro rata), v_{b(a)} = R v_{b(b)}. The
-/// rotation of the navigation frame over |b - a| <= kMaxSensorAssociation_s (< 4e-5 rad)
-/// is left out.
 Eigen::Quaterniond BodyRotation(const std::vector<ImuSample>& imu, double a, double b, const ImuErrors& e) {
   Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
   auto it = std::upper_bound(imu.begin(), imu.end(), a + kSameEpoch_s,
@@ -32,6 +26,10 @@ Eigen::Quaterniond BodyRotation(const std::vector<ImuSample>& imu, double a, dou
   }
   return q.normalized();
 }
+
+namespace {
+
+const char* const kMag = "mag";
 
 class MagSource : public AidingSource {
  public:
@@ -133,9 +131,9 @@ class MagSource : public AidingSource {
       const Eigen::Vector3d m_sample = CalibrateMag(sample.m_b_uT, config_);
       Eigen::Vector3d m = m_sample;
       if (sample.t_s > s.t_s) {
-        m = BodyRotation(batch.imu(), s.t_s, sample.t_s, s.initial->imu) * m_sample;
+        m = batch.BodyRotation(s.t_s, sample.t_s, s.initial->imu) * m_sample;
       } else if (sample.t_s < s.t_s) {
-        m = BodyRotation(batch.imu(), sample.t_s, s.t_s, s.initial->imu).conjugate() * m_sample;
+        m = batch.BodyRotation(sample.t_s, s.t_s, s.initial->imu).conjugate() * m_sample;
       }
       if (!m.allFinite()) {
         batch.Count(kMag, false);
