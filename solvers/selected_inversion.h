@@ -3,7 +3,9 @@
 // Chen 1973; Erisman and Tinney 1975).
 //
 // H is Jacobi-scaled, Hs = S H S with S = diag(1 / sqrt(H_ii)), factored Hs = P^T L D L^T P
-// (Eigen's SimplicialLDLT, AMD ordering), and Z = Hs^-1 computed on the pattern of L + L^T
+// (Eigen's SimplicialLDLT on the permuted upper triangle; P: approximate minimum degree on
+// the graph of the dense blocks, each block's columns kept together), and Z = Hs^-1 computed
+// on the pattern of L + L^T
 // backwards over the columns j:
 //   Z_jj = 1/d_j - sum_{k in L_j} l_kj Z_kj,   Z_ij = -sum_{k in L_j} l_kj Z_ik (i in L_j),
 // L_j the rows below the diagonal of column j. (H^-1)_ab = S_a S_b Z_ab. The cost is that of

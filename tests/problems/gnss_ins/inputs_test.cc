@@ -4,8 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -188,6 +190,48 @@ TEST(LoadInputs, BarometerAltitudeFromPressure) {
   // ISA: 89874.6 Pa at 1000 m geopotential (tables give 89874.6; 0.1 m covers the rounding).
   EXPECT_NEAR(in.baro[1].altitude_m, 1000.0, 0.1);
   ASSERT_EQ(in.mag.size(), 1u);  // the sample at 5 s is after the IMU span
+}
+
+// A streamed IMU record: until a pass has reached its end the other records run on past
+// it; after CutToImuEnd the inputs are those of the record in memory.
+TEST(LoadInputs, StreamedRecordCutAfterItsFirstPass) {
+  Files f = Write(ImuText(400, {200, 201}), GnssText(Times(0.0, 6.0, 0.1)));
+  f.paths.mag = WriteFile(f.dir + "/mag.csv", "t_s,mx_uT,my_uT,mz_uT\n0.5,20,1,40\n5.0,20,1,40\n");
+  GnssInsConfig c;
+  c.filter.max_bridge_gap_s = 0.05;
+  c.outages.start_s = 0.5;
+  c.outages.len_s = 0.5;
+  c.outages.period_s = 1.5;
+  const Inputs memory = LoadInputs(f.paths, c);
+  Inputs streamed = LoadInputs(f.paths, c, ImuStorage::kStreamed);
+  ASSERT_TRUE(streamed.imu.streamed());
+  EXPECT_FALSE(streamed.imu.end_known());
+  EXPECT_EQ(streamed.gnss.size() + streamed.gnss_removed.size(), 61u);  // every epoch after the IMU start
+  EXPECT_EQ(streamed.mag.size(), 2u);
+  const std::unique_ptr<ImuReader> pass = streamed.imu.Read();
+  const std::vector<ImuSample> samples = ReadAll(*pass);
+  CutToImuEnd(&streamed);
+  ASSERT_EQ(samples.size(), memory.imu.size());
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    ASSERT_EQ(samples[k].t_s, memory.imu[k].t_s) << k;
+    ASSERT_EQ(samples[k].dtheta_b_rad, memory.imu[k].dtheta_b_rad) << k;
+  }
+  EXPECT_EQ(streamed.imu.bridged_gaps(), 1u);
+  EXPECT_EQ(streamed.imu.bridged_gaps(), memory.imu.bridged_gaps());
+  EXPECT_EQ(streamed.gnss.size(), memory.gnss.size());
+  EXPECT_EQ(streamed.gnss_removed.size(), memory.gnss_removed.size());
+  EXPECT_EQ(streamed.gnss_removed_by_outages, memory.gnss_removed_by_outages);
+  EXPECT_EQ(streamed.outages, memory.outages);
+  EXPECT_EQ(streamed.mag.size(), 1u);
+  EXPECT_EQ(memory.mag.size(), 1u);
+}
+
+TEST(LoadInputs, StreamedRecordWithTheGnssAfterItsEnd) {
+  const Files f = Write(ImuText(200), GnssText({2.5, 3.0}));
+  Inputs in = LoadInputs(f.paths, GnssInsConfig(), ImuStorage::kStreamed);  // the IMU end is not known yet
+  const std::unique_ptr<ImuReader> pass = in.imu.Read();
+  EXPECT_EQ(ReadAll(*pass).size(), 200u);
+  ExpectInputError([&] { CutToImuEnd(&in); }, {f.paths.gnss, "no GNSS epoch inside the IMU span"});
 }
 
 }  // namespace gnss_ins_inputs_test
