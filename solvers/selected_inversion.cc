@@ -13,93 +13,173 @@
 namespace navtwin {
 namespace {
 
-/// True when every dense block's square is already on the pattern of H (as when one row of
-/// J touches all of a block's columns).
-bool HasDenseBlocks(const Eigen::SparseMatrix<double>& H, const std::vector<std::pair<int, int>>& dense_blocks) {
-  for (const auto& [first, size] : dense_blocks) {
-    for (int c = first; c < first + size; ++c) {
-      int inside = 0;
-      for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it) {
-        inside += it.row() >= first && it.row() < first + size;
-      }
-      if (inside != size) return false;
-    }
-  }
-  return true;
-}
+using IndexMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, Eigen::Index>;
 
-/// H = J^T J, plus explicit zeros that make each dense block's square part of the pattern
-/// where it is not already.
-Eigen::SparseMatrix<double> NormalMatrix(const ceres::CRSMatrix& crs,
-                                         const std::vector<std::pair<int, int>>& dense_blocks) {
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
-      crs.values.data());
-  Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(J.transpose()) * J;
-  if (HasDenseBlocks(H, dense_blocks)) return H;
-  std::vector<Eigen::Triplet<double>> pattern;
-  for (const auto& [first, size] : dense_blocks) {
-    for (int r = 0; r < size; ++r) {
-      for (int c = 0; c < size; ++c) pattern.emplace_back(first + r, first + c, 0.0);
-    }
-  }
-  Eigen::SparseMatrix<double> P(crs.num_cols, crs.num_cols);
-  P.setFromTriplets(pattern.begin(), pattern.end());
-  H = Eigen::SparseMatrix<double>(H + P);
-  H.makeCompressed();
-  return H;
-}
+/// The columns in blocks: the dense blocks, every other column a block of its own.
+struct ColumnBlocks {
+  std::vector<int> block_of;    ///< per column
+  std::vector<int> first, size;  ///< per block
+  std::vector<int> position;     ///< per block: its place in the elimination order
+  std::vector<int> new_first;    ///< per block: its first column in the permuted matrix
+  std::vector<std::vector<int>> adjacent;  ///< per block: the blocks sharing a row of J with it (itself included), sorted
+};
 
-/// The elimination order of the columns: approximate minimum degree (Amestoy, Davis and
-/// Duff 1996) on the graph of the blocks (each dense block one node, every other column
-/// its own), each block's columns kept together. Returns P with P.indices()(a) the
-/// position of column a in the order. Ordering the block graph, not the columns, keeps the
-/// work and memory of the ordering small beside the factorisation.
-Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> BlockOrdering(
-    const ceres::CRSMatrix& crs, const std::vector<std::pair<int, int>>& dense_blocks) {
-  const int n = crs.num_cols;
-  std::vector<int> block_of(n, -1);
-  std::vector<int> first_col, size;
+ColumnBlocks MakeBlocks(int n, const std::vector<std::pair<int, int>>& dense_blocks) {
+  ColumnBlocks b;
+  b.block_of.assign(n, -1);
   for (const auto& [first, cols] : dense_blocks) {
-    for (int c = first; c < first + cols; ++c) block_of[c] = static_cast<int>(first_col.size());
-    first_col.push_back(first);
-    size.push_back(cols);
+    for (int c = first; c < first + cols; ++c) b.block_of[c] = static_cast<int>(b.first.size());
+    b.first.push_back(first);
+    b.size.push_back(cols);
   }
   for (int c = 0; c < n; ++c) {
-    if (block_of[c] >= 0) continue;
-    block_of[c] = static_cast<int>(first_col.size());
-    first_col.push_back(c);
-    size.push_back(1);
+    if (b.block_of[c] >= 0) continue;
+    b.block_of[c] = static_cast<int>(b.first.size());
+    b.first.push_back(c);
+    b.size.push_back(1);
   }
-  const int nb = static_cast<int>(first_col.size());
-  // Block pairs sharing a row of J; the rows of one residual block repeat their set.
-  std::vector<Eigen::Triplet<double>> edges;
+  return b;
+}
+
+/// ColumnBlocks::adjacent from the rows of J (the rows of one residual block repeat their
+/// set of blocks: each set is added once).
+void FindAdjacentBlocks(const ceres::CRSMatrix& crs, ColumnBlocks* b) {
+  b->adjacent.assign(b->first.size(), {});
+  for (std::size_t k = 0; k < b->first.size(); ++k) b->adjacent[k].push_back(static_cast<int>(k));
   std::vector<int> row_blocks, previous;
   for (int r = 0; r < crs.num_rows; ++r) {
     row_blocks.clear();
-    for (int a = crs.rows[r]; a < crs.rows[r + 1]; ++a) row_blocks.push_back(block_of[crs.cols[a]]);
+    for (int a = crs.rows[r]; a < crs.rows[r + 1]; ++a) row_blocks.push_back(b->block_of[crs.cols[a]]);
     std::sort(row_blocks.begin(), row_blocks.end());
     row_blocks.erase(std::unique(row_blocks.begin(), row_blocks.end()), row_blocks.end());
     if (row_blocks == previous) continue;
-    for (std::size_t i = 0; i < row_blocks.size(); ++i) {
-      for (std::size_t j = 0; j < row_blocks.size(); ++j) edges.emplace_back(row_blocks[i], row_blocks[j], 1.0);
+    for (int x : row_blocks) {
+      std::vector<int>& adjacent = b->adjacent[static_cast<std::size_t>(x)];
+      adjacent.insert(adjacent.end(), row_blocks.begin(), row_blocks.end());
     }
     previous = row_blocks;
   }
-  for (int b = 0; b < nb; ++b) edges.emplace_back(b, b, 1.0);
+  for (std::vector<int>& adjacent : b->adjacent) {
+    std::sort(adjacent.begin(), adjacent.end());
+    adjacent.erase(std::unique(adjacent.begin(), adjacent.end()), adjacent.end());
+  }
+}
+
+/// The elimination order: approximate minimum degree (Amestoy, Davis and Duff 1996) on the
+/// graph of the blocks, each block's columns kept together (ColumnBlocks::position and
+/// new_first). Ordering the block graph, not the columns, keeps the work and memory of the
+/// ordering small beside the factorisation.
+void OrderBlocks(ColumnBlocks* b) {
+  const int nb = static_cast<int>(b->first.size());
   Eigen::SparseMatrix<double> graph(nb, nb);
-  graph.setFromTriplets(edges.begin(), edges.end());
-  edges.clear();
-  edges.shrink_to_fit();
+  Eigen::VectorXi per_column(nb);
+  for (int k = 0; k < nb; ++k) per_column(k) = static_cast<int>(b->adjacent[static_cast<std::size_t>(k)].size());
+  graph.reserve(per_column);
+  for (int k = 0; k < nb; ++k) {
+    for (int x : b->adjacent[static_cast<std::size_t>(k)]) graph.insert(x, k) = 1.0;
+  }
+  graph.makeCompressed();
   Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order;  // order.indices()(k): k-th block eliminated
   Eigen::AMDOrdering<int>()(graph, order);
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P(n);
+  b->position.assign(nb, 0);
+  b->new_first.assign(nb, 0);
   int next = 0;
   for (int k = 0; k < nb; ++k) {
-    const int b = order.indices()(k);
-    for (int c = first_col[b]; c < first_col[b] + size[b]; ++c) P.indices()(c) = next++;
+    const int block = order.indices()(k);
+    b->position[static_cast<std::size_t>(block)] = k;
+    b->new_first[static_cast<std::size_t>(block)] = next;
+    next += b->size[static_cast<std::size_t>(block)];
   }
-  return P;
+}
+
+/// The upper triangle of P J^T J P^T (P: the block order) on the block pattern (every pair
+/// of adjacent blocks dense, so each block's own square is on it), assembled from the
+/// rows of J without forming J^T J: entry (min(p_a, p_b), max(p_a, p_b)) gathers
+/// J_ra J_rb over the rows r, p_a the permuted index of column a.
+IndexMatrix PermutedNormalUpper(const ceres::CRSMatrix& crs, const ColumnBlocks& b, std::vector<int>* new_index) {
+  const int n = crs.num_cols;
+  new_index->assign(n, 0);
+  for (int c = 0; c < n; ++c) {
+    const int block = b.block_of[c];
+    (*new_index)[c] = b.new_first[static_cast<std::size_t>(block)] + c - b.first[static_cast<std::size_t>(block)];
+  }
+  // Pattern: column j of block B holds the columns of the adjacent blocks earlier in the
+  // order, then B's own columns up to j.
+  std::vector<int> block_at(n);  // permuted column -> block
+  for (std::size_t k = 0; k < b.first.size(); ++k) {
+    for (int i = 0; i < b.size[k]; ++i) block_at[b.new_first[k] + i] = static_cast<int>(k);
+  }
+  IndexMatrix H(n, n);
+  Eigen::Index nnz = 0;
+  std::vector<std::pair<int, int>> earlier;  // (position, block)
+  for (int pass = 0; pass < 2; ++pass) {
+    nnz = 0;
+    for (int j = 0; j < n; ++j) {
+      const auto block = static_cast<std::size_t>(block_at[j]);
+      if (pass == 1) H.outerIndexPtr()[j] = nnz;
+      earlier.clear();
+      for (int x : b.adjacent[block]) {
+        if (b.position[static_cast<std::size_t>(x)] < b.position[block]) earlier.emplace_back(b.position[static_cast<std::size_t>(x)], x);
+      }
+      std::sort(earlier.begin(), earlier.end());
+      for (const auto& [position, x] : earlier) {
+        for (int i = 0; i < b.size[static_cast<std::size_t>(x)]; ++i) {
+          if (pass == 1) H.innerIndexPtr()[nnz] = b.new_first[static_cast<std::size_t>(x)] + i;
+          ++nnz;
+        }
+      }
+      for (int i = b.new_first[block]; i <= j; ++i) {
+        if (pass == 1) H.innerIndexPtr()[nnz] = i;
+        ++nnz;
+      }
+    }
+    if (pass == 0) H.resizeNonZeros(nnz);
+  }
+  H.outerIndexPtr()[n] = nnz;
+  std::fill(H.valuePtr(), H.valuePtr() + nnz, 0.0);
+
+  std::vector<std::pair<int, double>> row;  // (permuted column, value), by column
+  for (int r = 0; r < crs.num_rows; ++r) {
+    row.clear();
+    for (int a = crs.rows[r]; a < crs.rows[r + 1]; ++a) row.emplace_back((*new_index)[crs.cols[a]], crs.values[a]);
+    std::sort(row.begin(), row.end());
+    for (std::size_t l = 0; l < row.size(); ++l) {
+      const int j = row[l].first;
+      const Eigen::Index* begin = H.innerIndexPtr() + H.outerIndexPtr()[j];
+      const Eigen::Index* end = H.innerIndexPtr() + H.outerIndexPtr()[j + 1];
+      const Eigen::Index* at = begin;
+      for (std::size_t k = 0; k <= l; ++k) {
+        at = std::lower_bound(at, end, static_cast<Eigen::Index>(row[k].first));
+        H.valuePtr()[at - H.innerIndexPtr()] += row[k].second * row[l].second;
+      }
+    }
+  }
+  return H;
+}
+
+/// Jacobi scaling of the permuted H in place: unit diagonal, so the pivots of the LDL^T lie
+/// in (0, 1] and the variance inflation of column a is Zs_aa. *scale: S in the Jacobian's
+/// column order (perm(a): the permuted index of column a). Returns why it failed, or "".
+std::string JacobiScale(const Eigen::VectorXi& perm, IndexMatrix* Hp, Eigen::VectorXd* scale) {
+  const int n = static_cast<int>(Hp->cols());
+  Eigen::VectorXd scale_permuted(n);
+  for (int j = 0; j < n; ++j) {
+    const double hjj = Hp->valuePtr()[Hp->outerIndexPtr()[j + 1] - 1];  // each column's last entry
+    if (!(hjj > 0.0) || !std::isfinite(hjj)) {
+      int column = 0;
+      while (perm(column) != j) ++column;
+      std::ostringstream text;
+      text << "tangent column " << column << " of the Jacobian is zero or not finite";
+      return text.str();
+    }
+    scale_permuted(j) = 1.0 / std::sqrt(hjj);
+  }
+  for (int j = 0; j < n; ++j) {
+    for (IndexMatrix::InnerIterator it(*Hp, j); it; ++it) it.valueRef() *= scale_permuted(it.row()) * scale_permuted(j);
+  }
+  scale->resize(n);
+  for (int a = 0; a < n; ++a) (*scale)(a) = scale_permuted(perm(a));
+  return {};
 }
 
 }  // namespace
@@ -107,37 +187,19 @@ Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> BlockOrdering(
 std::string SelectedInverse::Compute(const ceres::CRSMatrix& jacobian,
                                      const std::vector<std::pair<int, int>>& dense_blocks) {
   const int n = jacobian.num_cols;
-  Eigen::SparseMatrix<double> H = NormalMatrix(jacobian, dense_blocks);
+  ColumnBlocks blocks = MakeBlocks(n, dense_blocks);
+  FindAdjacentBlocks(jacobian, &blocks);
+  OrderBlocks(&blocks);
+  std::vector<int> new_index;
+  // The permuted upper triangle with Eigen::Index indices: with those (and
+  // NaturalOrdering<Eigen::Index>) the factorisation reads it in place instead of copying
+  // it for an ordering and a transposition.
+  IndexMatrix Hp = PermutedNormalUpper(jacobian, blocks, &new_index);
+  perm_ = Eigen::Map<const Eigen::VectorXi>(new_index.data(), n);
 
-  // Jacobi scaling: unit diagonal, so the pivots of the LDL^T lie in (0, 1] and the
-  // variance inflation of column a is Zs_aa.
-  scale_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const double hii = H.coeff(i, i);
-    if (!(hii > 0.0) || !std::isfinite(hii)) {
-      std::ostringstream text;
-      text << "tangent column " << i << " of the Jacobian is zero or not finite";
-      return text.str();
-    }
-    scale_(i) = 1.0 / std::sqrt(hii);
-  }
-  for (int k = 0; k < H.outerSize(); ++k) {
-    for (Eigen::SparseMatrix<double>::InnerIterator it(H, k); it; ++it) {
-      it.valueRef() *= scale_(it.row()) * scale_(it.col());
-    }
-  }
-  // Permuted to the block elimination order, upper triangle only, with Eigen::Index
-  // indices: with those (and NaturalOrdering<Eigen::Index>) the factorisation reads the
-  // matrix in place instead of copying it for an ordering and a transposition.
-  using IndexMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, Eigen::Index>;
-  const Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P = BlockOrdering(jacobian, dense_blocks);
-  IndexMatrix Hp;
-  {
-    Eigen::SparseMatrix<double> upper(n, n);
-    upper.selfadjointView<Eigen::Upper>() = H.selfadjointView<Eigen::Upper>().twistedBy(P);
-    Eigen::SparseMatrix<double>().swap(H);  // freed (assigning an empty matrix keeps the storage)
-    Hp = upper;
-  }
+  const std::string failure = JacobiScale(perm_, &Hp, &scale_);
+  if (!failure.empty()) return failure;
+
   Eigen::VectorXd d;
   {
     Eigen::SimplicialLDLT<IndexMatrix, Eigen::Upper, Eigen::NaturalOrdering<Eigen::Index>> ldlt(Hp);
@@ -152,7 +214,6 @@ std::string SelectedInverse::Compute(const ceres::CRSMatrix& jacobian,
         return text.str();
       }
     }
-    perm_ = P.indices();
 
     const IndexMatrix& factor = ldlt.matrixL().nestedExpression();
     start_.assign(n + 1, 0);
@@ -175,6 +236,13 @@ std::string SelectedInverse::Compute(const ceres::CRSMatrix& jacobian,
     }
   }
 
+  InvertOnPattern(d);
+  return {};
+}
+
+/// Z on the pattern of L + L^T from L (start_, rows_, values_) and the pivots d.
+void SelectedInverse::InvertOnPattern(const Eigen::VectorXd& d) {
+  const int n = static_cast<int>(d.size());
   // Backwards over the columns. For column j with rows r_1 < ... < r_m every entry
   // Z_{r_a r_b} needed lies in column min(r_a, r_b) of the pattern (the rows of a column of
   // L form a clique of the filled graph), so iterating column r_b of Z and keeping the rows
@@ -205,7 +273,6 @@ std::string SelectedInverse::Compute(const ceres::CRSMatrix& jacobian,
     }
     z_diag_[j] = diag;
   }
-  return {};
 }
 
 int SelectedInverse::Find(int row, int column) const {

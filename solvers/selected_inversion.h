@@ -3,10 +3,11 @@
 // Chen 1973; Erisman and Tinney 1975).
 //
 // H is Jacobi-scaled, Hs = S H S with S = diag(1 / sqrt(H_ii)), factored Hs = P^T L D L^T P
-// (Eigen's SimplicialLDLT on the permuted upper triangle; P: approximate minimum degree on
-// the graph of the dense blocks, each block's columns kept together), and Z = Hs^-1 computed
-// on the pattern of L + L^T
-// backwards over the columns j:
+// (Eigen's SimplicialLDLT), and Z = Hs^-1 computed on the pattern of L + L^T backwards over
+// the columns j. P keeps each dense block's columns together and orders the blocks by
+// approximate minimum degree on their graph; the upper triangle of P H P^T is assembled
+// from the rows of J on the blocks' pattern (every pair of blocks that share a row of J
+// dense) and factored in place: J^T J itself is never formed.
 //   Z_jj = 1/d_j - sum_{k in L_j} l_kj Z_kj,   Z_ij = -sum_{k in L_j} l_kj Z_ik (i in L_j),
 // L_j the rows below the diagonal of column j. (H^-1)_ab = S_a S_b Z_ab. The cost is that of
 // the factorisation: linear in the number of states for a chain of states.
@@ -44,6 +45,7 @@ class SelectedInverse {
   double Inflation(int a) const { return z_diag_[perm_(a)]; }
 
  private:
+  void InvertOnPattern(const Eigen::VectorXd& d);
   double Z(int p, int q) const;  ///< Zs in the permuted indices, NaN off the pattern
   int Find(int row, int column) const;
 
