@@ -231,12 +231,16 @@ void ImuPreintegration::Reset() {
 }
 
 double ImuPreintegration::t_start_s() const {
-  return samples_.empty() ? std::numeric_limits<double>::quiet_NaN()
-                          : samples_.front().t_s - samples_.front().dt_s;
+  return num_samples_ == 0 ? std::numeric_limits<double>::quiet_NaN() : t_start_s_;
 }
 
 double ImuPreintegration::t_end_s() const {
-  return samples_.empty() ? std::numeric_limits<double>::quiet_NaN() : samples_.back().t_s;
+  return num_samples_ == 0 ? std::numeric_limits<double>::quiet_NaN() : t_end_s_;
+}
+
+void ImuPreintegration::DropSamples() {
+  std::vector<ImuSample>().swap(samples_);
+  samples_dropped_ = true;
 }
 
 void ImuPreintegration::Integrate(const ImuSample& s) {
@@ -248,15 +252,18 @@ void ImuPreintegration::Integrate(const ImuSample& s) {
     throw std::invalid_argument("ImuPreintegration: sample at t = " + std::to_string(s.t_s) +
                                 " s has non-finite increments");
   }
-  if (!samples_.empty()) {
-    const double gap = (s.t_s - s.dt_s) - samples_.back().t_s;
+  if (num_samples_ > 0) {
+    const double gap = (s.t_s - s.dt_s) - t_end_s_;
     if (std::abs(gap) > std::max(1e-6, 1e-3 * s.dt_s)) {
       throw std::invalid_argument("ImuPreintegration: sample at t = " + std::to_string(s.t_s) +
                                   " s does not start where the previous one ended (gap " +
                                   std::to_string(gap) + " s)");
     }
   }
-  samples_.push_back(s);
+  if (num_samples_ == 0) t_start_s_ = s.t_s - s.dt_s;
+  t_end_s_ = s.t_s;
+  ++num_samples_;
+  if (!samples_dropped_) samples_.push_back(s);
   Propagate(s);
 }
 
@@ -270,6 +277,7 @@ void ImuPreintegration::Reintegrate(const Eigen::Vector3d& bg_lin_radps,
 
 void ImuPreintegration::Reintegrate(const ImuErrors& lin) {
   CheckLinearisation(lin, "ImuPreintegration::Reintegrate");
+  if (samples_dropped_) throw std::logic_error("ImuPreintegration::Reintegrate: the samples were dropped");
   lin_ = lin;
   Reset();
   for (const ImuSample& s : samples_) Propagate(s);
@@ -347,7 +355,7 @@ void ImuPreintegration::Propagate(const ImuSample& sample) {
 
 ImuPreintegration::Matrix9d ImuPreintegration::SqrtInformation() const {
   const Eigen::LLT<Matrix9d> llt(covariance_);
-  if (samples_.empty() || llt.info() != Eigen::Success) {
+  if (num_samples_ == 0 || llt.info() != Eigen::Success) {
     throw std::domain_error("ImuPreintegration: covariance not positive definite");
   }
   const Matrix9d L = llt.matrixL();

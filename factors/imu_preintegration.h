@@ -68,7 +68,7 @@ class ImuPreintegration {
   void Integrate(const ImuSample& s);
 
   /// Re-runs the integration from the stored samples at a new linearisation point (the
-  /// first form keeps the scale factors').
+  /// first form keeps the scale factors'). std::logic_error after DropSamples.
   void Reintegrate(const Eigen::Vector3d& bg_lin_radps, const Eigen::Vector3d& ba_lin_mps2);
   void Reintegrate(const ImuErrors& lin);
 
@@ -77,10 +77,13 @@ class ImuPreintegration {
   /// Start and end time of the integrated samples (NaN before the first sample).
   double t_start_s() const;
   double t_end_s() const;
-  std::size_t num_samples() const { return samples_.size(); }
-  /// Releases the spare capacity of the stored samples (when no more samples follow).
-  void ShrinkToFit() { samples_.shrink_to_fit(); }
+  std::size_t num_samples() const { return num_samples_; }
+  /// The samples integrated (empty after DropSamples).
   const std::vector<ImuSample>& samples() const { return samples_; }
+  /// Releases the stored samples, and stores none of those integrated later, when no
+  /// Reintegrate will follow (a caller that can give the samples again integrates them
+  /// into a new preintegration instead).
+  void DropSamples();
 
   /// Preintegrated rotation R_bi_bj (as a matrix and as a unit quaternion), velocity and
   /// position increments in body frame i (m/s, m) at the linearisation point.
@@ -136,6 +139,9 @@ class ImuPreintegration {
   ImuErrors lin_;
   double gyro_arw_, accel_vrw_;
   std::vector<ImuSample> samples_;
+  std::size_t num_samples_ = 0;
+  bool samples_dropped_ = false;
+  double t_start_s_ = 0.0, t_end_s_ = 0.0;  ///< of the samples integrated
   double dt_s_ = 0.0;
   Eigen::Quaterniond delta_q_;
   Eigen::Matrix3d delta_R_;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -24,6 +25,7 @@
 #include <ceres/problem.h>
 
 #include "core/imu_split.h"
+#include "core/io/input_error.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
 #include "factors/attitude_manifold.h"
@@ -192,6 +194,10 @@ class BatchSmoother : public ins::BatchAccess {
   void Check() const;
   void Initialise(const Plan& plan);
   void MechanizeAndPreintegrate();
+  using PieceSink = std::function<void(const ImuSample& piece, const ImuSample& sample, std::size_t interval, bool last)>;
+  std::size_t WalkPieces(ImuReader& reader, ImuSample sample, const std::function<void(double)>& on_time,
+                         const PieceSink& on_piece) const;
+  void ReintegrateFromFile(const std::vector<std::size_t>& intervals);
   void MakeViews();
   void BuildProblem();
   void AddImuFactor(std::size_t i);
@@ -234,6 +240,7 @@ class BatchSmoother : public ins::BatchAccess {
   /// The IMU samples (and the piece of the one holding t0) in the kMaxSensorAssociation_s
   /// before the first state: with the preintegrated pieces, the increments BodyRotation needs.
   std::vector<ImuSample> before_start_;
+  bool pieces_dropped_ = false;  ///< after BuildProblem: BodyRotation no longer available
   std::vector<ceres::ResidualBlockId> imu_factors_;
   std::map<std::string, MeasurementCount> counts_;
   /// A source's residual block (BatchAccess::Add): its count key and the time of its state.
@@ -447,7 +454,37 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     before_start_.push_back(SplitImuSample(sample, t0).first);
   }
   record_state();
-  for (; have && si < n; have = reader->Next(&sample)) {
+  if (have) {
+    WalkPieces(*reader, sample, events, [&](const ImuSample& piece, const ImuSample& whole, std::size_t, bool last) {
+      step(piece);
+      if (last && detector) detector->Add(CorrectImu(whole, errors));
+    });
+  }
+  if (si < n) {
+    std::ostringstream text;
+    text.precision(12);
+    text << "RunBatch: internal error, state at t = " << states_[si].t_s << " s beyond the IMU record";
+    throw std::logic_error(text.str());
+  }
+}
+
+/// The IMU samples from `sample` (the first ending after t0) on, in pieces split at every
+/// knot and state time after t0: on_piece(piece, sample, interval, last) for each piece
+/// (interval i: between states i and i + 1; last: the sample's last piece), on_time(t) at
+/// each of those times once the pieces before it are done. Stops at the last state;
+/// returns the number of states reached (all of them when the record covers them).
+std::size_t BatchSmoother::WalkPieces(ImuReader& reader, ImuSample sample, const std::function<void(double)>& on_time,
+                                      const PieceSink& on_piece) const {
+  const std::vector<NavEpoch>& knots = start_.epochs;
+  const std::size_t n = states_.size();
+  const double t0 = states_.front().t_s;
+  std::size_t kn = 1, si = 1;  // the next knot and state after t0
+  const auto reach = [&](double t) {
+    while (kn < knots.size() && knots[kn].state.nav.t_s <= t + ins::kSameEpoch_s) ++kn;
+    while (si < n && states_[si].t_s <= t + ins::kSameEpoch_s) ++si;
+    on_time(t);
+  };
+  for (bool have = true; have && si < n; have = reader.Next(&sample)) {
     ImuSample piece = sample;
     if (piece.t_s - piece.dt_s < t0 - ins::kSameEpoch_s) piece = SplitImuSample(piece, t0).second;
     while (true) {
@@ -456,23 +493,48 @@ void BatchSmoother::MechanizeAndPreintegrate() {
       if (next >= piece.t_s - ins::kSameEpoch_s) break;
       if (next > piece.t_s - piece.dt_s + ins::kSameEpoch_s) {
         const std::pair<ImuSample, ImuSample> parts = SplitImuSample(piece, next);
-        step(parts.first);
+        on_piece(parts.first, sample, si - 1, false);
         piece = parts.second;
       }
-      events(next);
+      reach(next);
       if (si >= n) break;
     }
     if (si >= n) break;
-    step(piece);
-    if (detector) detector->Add(CorrectImu(sample, errors));
-    events(piece.t_s);
+    on_piece(piece, sample, si - 1, true);
+    reach(piece.t_s);
   }
-  for (const std::shared_ptr<ImuPreintegration>& pre : pre_) pre->ShrinkToFit();
-  if (si < n) {
-    std::ostringstream text;
-    text.precision(12);
-    text << "RunBatch: internal error, state at t = " << states_[si].t_s << " s beyond the IMU record";
-    throw std::logic_error(text.str());
+  return si;
+}
+
+/// New preintegrations of the given intervals at their states' current IMU errors, from the
+/// IMU file read again and split exactly as MechanizeAndPreintegrate split it.
+void BatchSmoother::ReintegrateFromFile(const std::vector<std::size_t>& intervals) {
+  const ImuNoise& noise = cfg_.imu_noise;
+  std::vector<std::shared_ptr<ImuPreintegration>> fresh(pre_.size());
+  for (std::size_t i : intervals) {
+    fresh[i] = std::make_shared<ImuPreintegration>(ErrorsOf(states_[i]), noise.gyro_arw_rad_per_sqrt_s,
+                                                   noise.accel_vrw_mps_per_sqrt_s);
+    fresh[i]->DropSamples();  // integrates without keeping the pieces
+  }
+  const double t0 = states_.front().t_s;
+  const std::unique_ptr<ImuReader> reader = in_.imu.Read();
+  ImuSample sample;
+  bool have = false;
+  while (!have && reader->Next(&sample)) have = sample.t_s > t0 + ins::kSameEpoch_s;
+  if (have) {
+    WalkPieces(*reader, sample, [](double) {}, [&](const ImuSample& piece, const ImuSample&, std::size_t i, bool) {
+      if (fresh[i]) fresh[i]->Integrate(piece);
+    });
+  }
+  for (std::size_t i : intervals) {
+    if (fresh[i]->num_samples() != pre_[i]->num_samples()) {  // the IMU file changed under the run
+      std::ostringstream text;
+      text.precision(12);
+      text << "interval t = " << states_[i].t_s << " .. " << states_[i + 1].t_s << " s: " << fresh[i]->num_samples()
+           << " IMU pieces on reading the file again, " << pre_[i]->num_samples() << " before";
+      throw InputError(in_.paths.imu, 0, "t", text.str());
+    }
+    pre_[i] = fresh[i];
   }
 }
 
@@ -581,6 +643,7 @@ void BatchSmoother::AddAuxPriors() {
 /// ins::BodyRotation over the pieces of the intervals overlapping [a_s, b_s] (and the
 /// samples before the first state).
 Eigen::Quaterniond BatchSmoother::BodyRotation(double a_s, double b_s, const ImuErrors& errors) const {
+  if (pieces_dropped_) throw std::logic_error("BatchSmoother::BodyRotation: called after the problem was built");
   std::vector<ImuSample> pieces;
   if (a_s < states_.front().t_s) pieces = before_start_;
   const auto first = std::upper_bound(states_.begin(), states_.end(), a_s,
@@ -600,21 +663,22 @@ Eigen::Quaterniond BatchSmoother::BodyRotation(double a_s, double b_s, const Imu
 int BatchSmoother::Reintegrate() {
   const double arw = cfg_.imu_noise.gyro_arw_rad_per_sqrt_s;
   const double fixed = cfg_.batch.relinearize_bias_radps;
-  int count = 0;
+  std::vector<std::size_t> too_far;
   for (std::size_t i = 0; i < pre_.size(); ++i) {
-    ImuPreintegration& pre = *pre_[i];
+    const ImuPreintegration& pre = *pre_[i];
     const ImuErrors now = ErrorsOf(states_[i]);
     const double dt = pre.dt_s();
     const Eigen::Vector3d dbg = now.bg_radps - pre.bg_lin_radps();
     const Eigen::Vector3d correction_rad = pre.J_R_bg() * dbg + pre.J_R_sg() * (now.sg - pre.lin().sg);
-    const bool too_far = fixed > 0.0 ? dbg.norm() > fixed : correction_rad.norm() > 0.1 * arw * std::sqrt(dt);
-    if (!too_far) continue;
-    pre.Reintegrate(now);
+    if (fixed > 0.0 ? dbg.norm() > fixed : correction_rad.norm() > 0.1 * arw * std::sqrt(dt)) too_far.push_back(i);
+  }
+  if (too_far.empty()) return 0;
+  ReintegrateFromFile(too_far);
+  for (std::size_t i : too_far) {
     problem_->RemoveResidualBlock(imu_factors_[i]);
     AddImuFactor(i);
-    ++count;
   }
-  return count;
+  return static_cast<int>(too_far.size());
 }
 
 std::vector<int> BatchSmoother::SourceRowGroups(const std::string& key) {
@@ -753,6 +817,11 @@ Solution BatchSmoother::Run() {
   MechanizeAndPreintegrate();
   MakeViews();
   BuildProblem();
+  // The sources have carried their samples to the states (BodyRotation): the pieces go;
+  // a reintegration reads the IMU file again.
+  for (const std::shared_ptr<ImuPreintegration>& pre : pre_) pre->DropSamples();
+  std::vector<ImuSample>().swap(before_start_);
+  pieces_dropped_ = true;
   {
     std::ostringstream line;
     line.precision(3);

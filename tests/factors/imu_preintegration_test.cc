@@ -775,5 +775,38 @@ TEST(ImuPreintegration, RejectsBadInput) {
   EXPECT_EQ(f->num_residuals(), 9);
 }
 
+// DropSamples: the preintegration keeps its increments, covariance, Jacobians, times and
+// count (a factor can still be made from it), and refuses to reintegrate; more samples
+// integrate as before, at the same continuity check.
+TEST(ImuPreintegration, DropSamplesKeepsTheResultAndRefusesToReintegrate) {
+  const Eigen::Vector3d z = Eigen::Vector3d::Zero();
+  ImuPreintegration kept(z, z, kArw, kVrw), dropped(z, z, kArw, kVrw);
+  ImuSample s;
+  s.dt_s = 0.005;
+  for (int k = 1; k <= 40; ++k) {
+    s.t_s = 0.005 * k;
+    s.dtheta_b_rad = Eigen::Vector3d(1e-4, -2e-4 * k, 3e-5);
+    s.dv_b_mps = Eigen::Vector3d(0.01, 0.002 * k, -0.049);
+    kept.Integrate(s);
+    dropped.Integrate(s);
+    if (k == 20) dropped.DropSamples();
+  }
+  EXPECT_TRUE(dropped.samples().empty());
+  EXPECT_EQ(dropped.num_samples(), 40u);
+  EXPECT_EQ(dropped.t_start_s(), kept.t_start_s());
+  EXPECT_EQ(dropped.t_end_s(), kept.t_end_s());
+  EXPECT_EQ(dropped.delta_v_mps(), kept.delta_v_mps());
+  EXPECT_EQ(dropped.delta_p_m(), kept.delta_p_m());
+  EXPECT_EQ(dropped.covariance(), kept.covariance());
+  EXPECT_EQ(dropped.J_v_bg(), kept.J_v_bg());
+  EXPECT_EQ(dropped.SqrtInformation(), kept.SqrtInformation());
+  EXPECT_THROW(dropped.Reintegrate(Eigen::Vector3d::Constant(1e-5), z), std::logic_error);
+  s.t_s += 0.02;  // a gap is still refused
+  EXPECT_THROW(dropped.Integrate(s), std::invalid_argument);
+  auto shared = std::make_shared<ImuPreintegration>(dropped);
+  std::unique_ptr<ceres::CostFunction> f(CreateImuFactor(shared));
+  EXPECT_EQ(f->num_residuals(), 9);
+}
+
 }  // namespace factors_imu_preintegration_test
 }  // namespace navtwin
