@@ -3,9 +3,12 @@
 //   fuzz_replay_<target> <corpus folder> <regressions folder> [--data=FILE[+TAG]...]
 // --data seeds come from the real records (never copied into the repository): the first
 // 8 KB of $NAVTWIN_DATA/FILE (else the configured ../shared/data), cut at a line end, with
-// the whole of TAG appended when given (rtklib-walk's tag file). A missing data file fails
-// the replay when CI is set, else it is skipped. Fails when no input was replayed at all
-// (a replay of nothing would pass unseen); a missing regressions folder is an empty one. A crash or an unexpected exception in the
+// the whole of TAG appended when given (rtklib-walk's tag file); of a binary ULog (.ulg) the
+// first 64 KB as they are (past the definitions to the first data messages). A missing data
+// file fails the replay when CI is set, else it is skipped. Fails when no input was
+// replayed at all (a replay of nothing would pass unseen), unless only skipped data seeds
+// were given: then exit code 77, which ctest reports as skipped. A missing corpus or
+// regressions folder is an empty one. A crash or an unexpected exception in the
 // target ends the program abnormally, which is the finding.
 #include <algorithm>
 #include <cstddef>
@@ -39,6 +42,8 @@ std::vector<std::uint8_t> Bytes(const std::filesystem::path& file) {
 }
 
 constexpr std::size_t kDataHead = 8192;
+constexpr std::size_t kBinaryHead = 65536;
+constexpr int kSkipped = 77;
 
 std::filesystem::path DataDir() {
   const char* env = std::getenv("NAVTWIN_DATA");
@@ -51,9 +56,11 @@ bool DataSeed(const std::string& spec, std::vector<std::uint8_t>* bytes) {
   const std::filesystem::path file = DataDir() / spec.substr(0, plus);
   if (!std::filesystem::is_regular_file(file)) return false;
   *bytes = Bytes(file);
-  if (bytes->size() > kDataHead) {
-    bytes->resize(kDataHead);
-    while (!bytes->empty() && bytes->back() != '\n') bytes->pop_back();
+  const bool binary = file.extension() == ".ulg";
+  const std::size_t head = binary ? kBinaryHead : kDataHead;
+  if (bytes->size() > head) {
+    bytes->resize(head);
+    while (!binary && !bytes->empty() && bytes->back() != '\n') bytes->pop_back();
   }
   if (plus == std::string::npos) return true;
   const std::filesystem::path tag = DataDir() / spec.substr(plus + 1);
@@ -63,8 +70,8 @@ bool DataSeed(const std::string& spec, std::vector<std::uint8_t>* bytes) {
   return true;
 }
 
-/// The --data seeds; -1 when one is missing under CI.
-long ReplayData(const std::vector<std::string>& specs) {
+/// The --data seeds; -1 when one is missing under CI. *skipped: those missing otherwise.
+long ReplayData(const std::vector<std::string>& specs, std::size_t* skipped) {
   long count = 0;
   for (const std::string& spec : specs) {
     std::vector<std::uint8_t> bytes;
@@ -72,6 +79,7 @@ long ReplayData(const std::vector<std::string>& specs) {
       std::fprintf(stderr, "data seed %s not found under %s%s\n", spec.c_str(), DataDir().string().c_str(),
                    std::getenv("CI") != nullptr ? "" : " (skipped)");
       if (std::getenv("CI") != nullptr) return -1;
+      ++*skipped;
       continue;
     }
     std::printf("replay data %s\n", spec.c_str());
@@ -110,8 +118,13 @@ int main(int argc, char** argv) {
   }
   const std::size_t corpus = replay_main::Replay(replay_main::InputsIn(argv[1]));
   const std::size_t regressions = replay_main::Replay(replay_main::InputsIn(argv[2]));
-  const long seeds = replay_main::ReplayData(data);
+  std::size_t skipped = 0;
+  const long seeds = replay_main::ReplayData(data, &skipped);
   if (seeds < 0) return 1;
+  if (corpus + static_cast<std::size_t>(seeds) == 0 && skipped > 0) {
+    std::fprintf(stderr, "only data seeds, all missing: skipped\n");
+    return replay_main::kSkipped;
+  }
   if (corpus + static_cast<std::size_t>(seeds) == 0) {
     std::fprintf(stderr, "no input replayed from %s or the data seeds\n", argv[1]);
     return 1;
