@@ -194,6 +194,7 @@ class BatchSmoother : public ins::BatchAccess {
   void Check() const;
   void Initialise(const Plan& plan);
   void MechanizeAndPreintegrate();
+  bool ReadToStart(ImuReader& reader, ImuSample* sample, const std::function<void(const ImuSample&)>& before) const;
   using PieceSink = std::function<void(const ImuSample& piece, const ImuSample& sample, std::size_t interval, bool last)>;
   std::size_t WalkPieces(ImuReader& reader, ImuSample sample, const std::function<void(double)>& on_time,
                          const PieceSink& on_piece) const;
@@ -436,20 +437,17 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   // window (and are kept for BodyRotation when close to t0); the angular rate at t0 is the
   // one of the sample that ends at or contains t0.
   const std::unique_ptr<ImuReader> reader = in_.imu.Read();
+  bool omega_set = false;
   ImuSample sample;
-  bool have = false, omega_set = false;
-  while (reader->Next(&sample)) {
-    if (!omega_set && sample.t_s >= t0 - ins::kSameEpoch_s) {
-      omega = CorrectImu(sample, errors).dtheta_b_rad / sample.dt_s;
+  const bool have = ReadToStart(*reader, &sample, [&](const ImuSample& s) {
+    if (!omega_set && s.t_s >= t0 - ins::kSameEpoch_s) {
+      omega = CorrectImu(s, errors).dtheta_b_rad / s.dt_s;
       omega_set = true;
     }
-    if (sample.t_s > t0 + ins::kSameEpoch_s) {
-      have = true;
-      break;
-    }
-    if (detector && sample.t_s > t0 - still_rule->window_s - 1.0) detector->Add(CorrectImu(sample, errors));
-    if (sample.t_s > t0 - ins::kMaxSensorAssociation_s - 1.0) before_start_.push_back(sample);
-  }
+    if (detector && s.t_s > t0 - still_rule->window_s - 1.0) detector->Add(CorrectImu(s, errors));
+    if (s.t_s > t0 - ins::kMaxSensorAssociation_s - 1.0) before_start_.push_back(s);
+  });
+  if (have && !omega_set) omega = CorrectImu(sample, errors).dtheta_b_rad / sample.dt_s;
   if (have && sample.t_s - sample.dt_s < t0 - ins::kSameEpoch_s) {
     before_start_.push_back(SplitImuSample(sample, t0).first);
   }
@@ -466,6 +464,18 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     text << "RunBatch: internal error, state at t = " << states_[si].t_s << " s beyond the IMU record";
     throw std::logic_error(text.str());
   }
+}
+
+/// Reads `reader` to the first sample ending after t0 (into *sample; false: none), giving
+/// each sample before it to `before`.
+bool BatchSmoother::ReadToStart(ImuReader& reader, ImuSample* sample,
+                                const std::function<void(const ImuSample&)>& before) const {
+  const double t0 = states_.front().t_s;
+  while (reader.Next(sample)) {
+    if (sample->t_s > t0 + ins::kSameEpoch_s) return true;
+    before(*sample);
+  }
+  return false;
 }
 
 /// The IMU samples from `sample` (the first ending after t0) on, in pieces split at every
@@ -516,12 +526,9 @@ void BatchSmoother::ReintegrateFromFile(const std::vector<std::size_t>& interval
                                                    noise.accel_vrw_mps_per_sqrt_s);
     fresh[i]->DropSamples();  // integrates without keeping the pieces
   }
-  const double t0 = states_.front().t_s;
   const std::unique_ptr<ImuReader> reader = in_.imu.Read();
   ImuSample sample;
-  bool have = false;
-  while (!have && reader->Next(&sample)) have = sample.t_s > t0 + ins::kSameEpoch_s;
-  if (have) {
+  if (ReadToStart(*reader, &sample, [](const ImuSample&) {})) {
     WalkPieces(*reader, sample, [](double) {}, [&](const ImuSample& piece, const ImuSample&, std::size_t i, bool) {
       if (fresh[i]) fresh[i]->Integrate(piece);
     });

@@ -246,13 +246,11 @@ class NavigationFilter : public ins::FilterAccess {
     output_(output_epoch_);
   }
 
-  /// About every 5 % of the record's time span (a streamed record whose end is not known
-  /// yet: of the span up to the last GNSS epoch).
+  /// About every 5 % of [progress_begin_s_, progress_end_s_].
   void Progress(double t_s) {
     if (progress_ == nullptr) return;
-    const double begin_s = in_.imu.begin_s();
-    const double end_s = in_.imu.end_known() ? in_.imu.back().t_s : in_.gnss.empty() ? t_s : in_.gnss.back().t_s;
-    const double fraction = end_s > begin_s ? (t_s - begin_s) / (end_s - begin_s) : 1.0;
+    const double fraction =
+        progress_end_s_ > progress_begin_s_ ? (t_s - progress_begin_s_) / (progress_end_s_ - progress_begin_s_) : 1.0;
     const int step = static_cast<int>(std::min(20.0, std::floor(20.0 * fraction + 1e-9)));
     if (step <= progress_step_) return;
     progress_step_ = step;
@@ -290,6 +288,9 @@ class NavigationFilter : public ins::FilterAccess {
   NavEpoch output_epoch_;
   mutable InsState nominal_;
   int progress_step_ = 0;
+  /// The span Progress measures: the IMU record's, or up to the last GNSS epoch while a
+  /// streamed record's end is not known.
+  double progress_begin_s_ = 0.0, progress_end_s_ = 0.0;
 
   // Covariance group.
   Eigen::Vector3d group_dtheta_ = Eigen::Vector3d::Zero();
@@ -461,6 +462,10 @@ FilterResult NavigationFilter::Run() {
   const std::unique_ptr<ImuReader> imu = in_.imu.Read();
   ImuSample sample, next;
   FirstImuSample(*imu, &sample);
+  progress_begin_s_ = in_.imu.begin_s();
+  progress_end_s_ = in_.imu.end_known()   ? in_.imu.back().t_s
+                    : in_.gnss.empty() ? progress_begin_s_
+                                       : in_.gnss.back().t_s;
 
   // Knot 0: the initial state, with the measurements at the start time.
   SkipMeasurementsBeforeStart(t0);

@@ -199,16 +199,18 @@ std::vector<MagSample> ReadMag(const std::string& path, const std::optional<MagC
   return out;
 }
 
+InputError NoOdometerInSpan(const std::string& path, double t_begin_s, double t_end_s) {
+  return InputError(path, 0, "t", "no odometer sample inside the IMU record [" + Num(t_begin_s) + ", " +
+                                      Num(t_end_s) + "] s");
+}
+
 /// Odometer speeds inside [t_begin, t_end]; none there is an InputError.
 std::vector<OdometerSample> ReadOdometerSpan(const std::string& path, double t_begin, double t_end) {
   std::vector<OdometerSample> out;
   for (const OdometerSample& s : ReadOdometer(path)) {
     if (s.t_s >= t_begin - ins::kSameEpoch_s && s.t_s <= t_end + ins::kSameEpoch_s) out.push_back(s);
   }
-  if (out.empty()) {
-    throw InputError(path, 0, "t", "no odometer sample inside the IMU record [" + Num(t_begin) + ", " +
-                                       Num(t_end) + "] s");
-  }
+  if (out.empty()) throw NoOdometerInSpan(path, t_begin, t_end);
   return out;
 }
 
@@ -313,10 +315,7 @@ void CutToImuEnd(Inputs* in) {
   CutAfter(t_end, &in->baro);
   if (!in->odometer.empty()) {
     CutAfter(t_end, &in->odometer);
-    if (in->odometer.empty()) {
-      throw InputError(in->odometer_file, 0, "t", "no odometer sample inside the IMU record [" +
-                                                     Num(in->imu.begin_s()) + ", " + Num(t_end) + "] s");
-    }
+    if (in->odometer.empty()) throw NoOdometerInSpan(in->odometer_file, in->imu.begin_s(), t_end);
   }
 }
 
