@@ -19,7 +19,7 @@ TransferConfig ParseRoot(const ConfigNode& n) {
   n.RequireKeys({"gyro_bias_deg_h", "gyro_arw_deg_sqrt_h", "accel_bias_ug", "accel_vrw_m_s_sqrt_h",
                  "initial_velocity_mps", "initial_attitude_deg", "misalignment_deg", "delay_s", "delay_initial_s",
                  "master_attitude_mrad", "master_velocity_mps", "master_fit_window_s", "lever_arm_b_m", "settle_s",
-                 "batch_state_interval_s", "batch_max_iterations"});
+                 "batch_state_interval_s", "batch_max_iterations", "history_window_s"});
   TransferConfig c;
   // Slave sensor: biases and noise densities may be 0 (a sensor without that error).
   c.gyro_bias_radps = n.NonNegativeSi("gyro_bias_deg_h", kDegPerHour_radps, c.gyro_bias_radps);
@@ -45,6 +45,7 @@ TransferConfig ParseRoot(const ConfigNode& n) {
   c.settle_s = n.NonNegative("settle_s", c.settle_s);
   c.batch_state_interval_s = n.Positive("batch_state_interval_s", c.batch_state_interval_s);
   c.batch_max_iterations = n.Int("batch_max_iterations", c.batch_max_iterations, 1, 100000);
+  c.history_window_s = n.Positive("history_window_s", c.history_window_s);
   return c;
 }
 

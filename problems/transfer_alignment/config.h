@@ -43,6 +43,10 @@ struct TransferConfig {
   /// Batch: slave states every this many seconds (a master record near each), s.
   double batch_state_interval_s = 0.1;
   int batch_max_iterations = 30;
+  /// The history filter (history_filter.h) keeps the slave's past over this span, s: the
+  /// largest delay it can match. A record whose data time (tag - tau) falls before the kept
+  /// history is not used (counted and reported).
+  double history_window_s = 1.0;
 };
 
 /// Reads a YAML file (keys = the member names above, or the people-unit key named beside a

@@ -6,14 +6,8 @@
 // estimate): dx = [dv_n (3), phi_n (3), mu_b (3), dtau (1)] with
 //   v_true = v + dv,  R_n_s_true = Exp(phi) R_n_s,  M_true = Exp(mu) M,  tau_true = tau + dtau.
 //
-// Propagation, per IMU sample (or part of one, when a master tag splits it): dv and phi
-// follow the INS error model of problems/ins/error_dynamics.h (its dv/phi rows and
-// columns; the position errors are left out because the position is reset from the master
-// at every record, and the slave biases are not states), mu and dtau are random constants
-// with small random walks. Phi = I + F dt + (F dt)^2 / 2; Qd = diag(q) dt with
-//   q_v   = VRW^2 + sigma_ba^2 T_b,   q_phi = ARW^2 + sigma_bg^2 T_b,
-// where the unestimated bias is covered by white noise whose variance grows like the
-// bias's effect over the filter's memory T_b: sigma_b^2 T_b^2 = q T_b.
+// Propagation, per IMU sample (or part of one, when a master tag splits it), and the
+// process noise: the shared model of problems/transfer_alignment/filter_model.h.
 //
 // Update at every master record whose tag lies inside the slave span: the INS is stepped
 // to the tag, its position reset from the record carried forward over tau (the record
@@ -43,160 +37,51 @@
 
 #include <Eigen/Cholesky>
 
-#include "core/earth.h"
-#include "core/imu_split.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
-#include "core/units.h"
-#include "problems/ins/error_dynamics.h"
-#include "problems/ins/ins_state.h"
 #include "problems/transfer_alignment/master.h"
 #include "solvers/eskf.h"
 
 namespace navtwin::transfer {
 namespace {
 
-// Records in the master-derivative fit window (config.h master_fit_window_s): the window
-// over the median record spacing, at least 3; 0 (differences) for a zero window.
-int FitRecords(const std::vector<NavState>& master, double window_s) {
-  if (!(window_s > 0.0) || master.size() < 3) return 0;
-  std::vector<double> dts;
-  for (std::size_t k = 1; k < master.size(); ++k) dts.push_back(master[k].t_s - master[k - 1].t_s);
-  std::nth_element(dts.begin(), dts.begin() + dts.size() / 2, dts.end());
-  const double dt = dts[dts.size() / 2];
-  if (!(dt > 0.0)) return 0;
-  return std::max(3, static_cast<int>(std::lround(window_s / dt)) + 1);
-}
-
-
-using Matrix10 = Eigen::Matrix<double, kTransferStates, kTransferStates>;
-using Vector10 = Eigen::Matrix<double, kTransferStates, 1>;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
+using Matrix10 = TransferMatrix;
+using Vector10 = TransferVector;
+using tstate::kAtt;
+using tstate::kMis;
+using tstate::kTau;
+using tstate::kVel;
 
-// Error-state blocks.
-constexpr int kVel = 0;
-constexpr int kAtt = 3;
-constexpr int kMis = 6;
-constexpr int kTau = 9;
-
-// Memory over which an unestimated slave bias is covered by process noise (see the header
-// comment): the attitude matching observes phi at 50 Hz, so the filter's memory of phi is
-// seconds; 10 s makes the bias term about equal to the tactical ARW term.
-constexpr double kBiasMemory_s = 10.0;
-// Random walks of the misalignment (structural flexure) and of the delay (clock wander):
-// 1 urad/sqrt(s) gives 14 urad over 200 s, 10 us/sqrt(s) 0.14 ms, both far below what the
-// filter resolves, so they only keep the gains from vanishing.
-constexpr double kMisalignmentWalk_rad_sqrt_s = 1e-6;
-constexpr double kDelayWalk_s_sqrt_s = 1e-5;
-constexpr double kTimeEpsilon_s = 1e-9;
 constexpr double kGateProbability = 1.0;  // no gate: see the header comment
 constexpr int kUpdateIterations = 3;
-
-void Require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("RunTransferFilter: configuration: " + what);
-}
-
-void CheckFilterConfig(const TransferConfig& c) {
-  auto non_negative = [](double x) { return std::isfinite(x) && x >= 0.0; };
-  auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
-  Require(non_negative(c.gyro_bias_radps), "gyro_bias_radps must be >= 0");
-  Require(non_negative(c.gyro_arw_rad_per_sqrt_s), "gyro_arw_rad_per_sqrt_s must be >= 0");
-  Require(non_negative(c.accel_bias_mps2), "accel_bias_mps2 must be >= 0");
-  Require(non_negative(c.accel_vrw_mps_per_sqrt_s), "accel_vrw_mps_per_sqrt_s must be >= 0");
-  Require(positive(c.initial_velocity_mps), "initial_velocity_mps must be > 0");
-  Require(positive(c.initial_attitude_rad), "initial_attitude_rad must be > 0");
-  Require(positive(c.misalignment_rad), "misalignment_rad must be > 0");
-  Require(positive(c.delay_s), "delay_s must be > 0");
-  Require(std::isfinite(c.delay_initial_s), "delay_initial_s must be finite");
-  Require(positive(c.master_attitude_rad), "master_attitude_rad must be > 0");
-  Require(positive(c.master_velocity_mps), "master_velocity_mps must be > 0");
-  Require(c.lever_arm_b_m.allFinite(), "lever_arm_b_m must be finite");
-}
-
-// The master record's position carried forward over tau with its velocity (local NED
-// offset v tau on the ellipsoid's radii; metres of error at most, which the velocity
-// dynamics barely feel).
-void ResetPosition(const NavState& record, double tau_s, NavState* slave) {
-  const double lat = record.lat_rad, h = record.h_m;
-  const Vector3d d_n_m = record.v_n_mps * tau_s;
-  slave->lat_rad = lat + d_n_m.x() / (wgs84::MeridianRadius(lat) + h);
-  slave->lon_rad = record.lon_rad + d_n_m.y() / ((wgs84::PrimeVerticalRadius(lat) + h) * std::cos(lat));
-  slave->h_m = h - d_n_m.z();
-}
 
 class TransferFilter {
  public:
   TransferFilter(const TransferInputs& in, const TransferConfig& cfg, DelayOrder order)
-      : in_(in), cfg_(cfg), order_(order), master_(in.master, DerivativeMode::kCausal, in.master_path, FitRecords(in.master, cfg.master_fit_window_s)),
-        ins_(in.slave_initial), kf_(InitialCovariance(cfg)) {
+      : cfg_(cfg), order_(order),
+        master_(in.master, DerivativeMode::kCausal, in.master_path, MasterFitRecords(in.master, cfg.master_fit_window_s)),
+        ins_(in.slave_initial), kf_(InitialCovariance(cfg)), q_(TransferProcessNoise(cfg)), slave_imu_(in.slave_imu) {
     misalignment_ = in.misalignment_guess.normalized();
     tau_s_ = cfg.delay_initial_s;
-    noise_.gyro_arw_rad_per_sqrt_s = cfg.gyro_arw_rad_per_sqrt_s;
-    noise_.accel_vrw_mps_per_sqrt_s = cfg.accel_vrw_mps_per_sqrt_s;
-    const double bg = cfg.gyro_bias_radps, ba = cfg.accel_bias_mps2;
-    q_.segment<3>(kVel).setConstant(std::pow(noise_.accel_vrw_mps_per_sqrt_s, 2) + ba * ba * kBiasMemory_s);
-    q_.segment<3>(kAtt).setConstant(std::pow(noise_.gyro_arw_rad_per_sqrt_s, 2) + bg * bg * kBiasMemory_s);
-    q_.segment<3>(kMis).setConstant(kMisalignmentWalk_rad_sqrt_s * kMisalignmentWalk_rad_sqrt_s);
-    q_(kTau) = kDelayWalk_s_sqrt_s * kDelayWalk_s_sqrt_s;
   }
 
   void Run(TransferFilterRun* out) {
-    const double t_end = in_.slave_imu.back().t_s;
-    std::size_t next = 0;  // next master record to use
-    // Records before the slave's start are outside its span.
-    while (next < master_.size() && master_.record(next).t_s < ins_.state().t_s - kTimeEpsilon_s) ++next;
-    auto update_due = [&](double t_s) {
-      return next < master_.size() && master_.record(next).t_s <= t_s + kTimeEpsilon_s &&
-             master_.record(next).t_s <= t_end + kTimeEpsilon_s;
-    };
-    // A record at the initial time.
-    while (update_due(ins_.state().t_s)) Update(next++, out);
-    for (const ImuSample& raw : in_.slave_imu) {
-      const double t_ins = ins_.state().t_s;
-      if (raw.t_s <= t_ins + kTimeEpsilon_s) continue;  // before the start
-      ImuSample cur = raw;
-      if (cur.t_s - cur.dt_s < t_ins - kTimeEpsilon_s) cur = SplitImuSample(cur, t_ins).second;
-      // Records tagged inside the sample: split at the tag.
-      while (update_due(cur.t_s) && master_.record(next).t_s < cur.t_s - kTimeEpsilon_s) {
-        const double tag = master_.record(next).t_s;
-        if (tag > ins_.state().t_s + kTimeEpsilon_s) {
-          auto parts = SplitImuSample(cur, tag);
-          Propagate(parts.first);
-          cur = parts.second;
-        }
-        Update(next++, out);
-      }
-      Propagate(cur);
-      while (update_due(cur.t_s)) Update(next++, out);
-    }
+    WalkSlaveImu(
+        slave_imu_, master_, ins_.state().t_s, [this](const ImuSample& s) { Propagate(s); },
+        [this, out](std::size_t k) { Update(k, out); });
   }
 
  private:
   static Eigen::MatrixXd InitialCovariance(const TransferConfig& c) {
-    CheckFilterConfig(c);
-    Vector10 sd;
-    sd.segment<3>(kVel).setConstant(c.initial_velocity_mps);
-    sd.segment<3>(kAtt).setConstant(c.initial_attitude_rad);
-    sd.segment<3>(kMis).setConstant(c.misalignment_rad);
-    sd(kTau) = c.delay_s;
-    return Eigen::MatrixXd(sd.cwiseAbs2().asDiagonal());
+    CheckTransferFilterConfig(c, "RunTransferFilter");
+    return Eigen::MatrixXd(TransferInitialSigma(c).cwiseAbs2().asDiagonal());
   }
 
   void Propagate(const ImuSample& s) {
-    const double dt = s.dt_s;
-    ins::InsState x;
-    x.nav = ins_.state();
-    const Vector3d f_s = s.dv_b_mps / dt, w_s = s.dtheta_b_rad / dt;
-    const Eigen::MatrixXd F15 = ins::ErrorDynamicsF(x, f_s, w_s, noise_, ins::err::kSize15);
-    Matrix10 F = Matrix10::Zero();
-    F.block<3, 3>(kVel, kVel) = F15.block<3, 3>(ins::err::kVel, ins::err::kVel);
-    F.block<3, 3>(kVel, kAtt) = F15.block<3, 3>(ins::err::kVel, ins::err::kAtt);
-    F.block<3, 3>(kAtt, kVel) = F15.block<3, 3>(ins::err::kAtt, ins::err::kVel);
-    F.block<3, 3>(kAtt, kAtt) = F15.block<3, 3>(ins::err::kAtt, ins::err::kAtt);
-    const Matrix10 Fdt = F * dt;
-    const Matrix10 Phi = Matrix10::Identity() + Fdt + 0.5 * Fdt * Fdt;
-    const Matrix10 Qd = Matrix10((q_ * dt).asDiagonal());
+    const Matrix10 Phi = TransferTransition(ins_.state(), s);
+    const Matrix10 Qd = Matrix10((q_ * s.dt_s).asDiagonal());
     kf_.Predict(Phi, Qd);
     ins_.Update(s);
   }
@@ -204,7 +89,7 @@ class TransferFilter {
   void Update(std::size_t k, TransferFilterRun* out) {
     const MasterKinematics& kin = master_.kinematics(k);
     NavState s = ins_.state();
-    ResetPosition(master_.record(k), tau_s_, &s);
+    ResetSlavePosition(master_.record(k), tau_s_, &s);
     const Eigen::Matrix<double, 6, 1> sigma = MeasurementSigma(k);
     const Eigen::Matrix<double, 6, 1> inv_sigma = sigma.cwiseInverse();
     // Iterated update (Gauss-Newton on the prior plus this record): relinearise at
@@ -293,7 +178,6 @@ class TransferFilter {
     throw std::runtime_error(m.str());
   }
 
-  const TransferInputs& in_;
   const TransferConfig& cfg_;
   DelayOrder order_;
   MasterStream master_;
@@ -301,8 +185,8 @@ class TransferFilter {
   ErrorStateKalmanFilter kf_;
   Eigen::Quaterniond misalignment_;
   double tau_s_ = 0.0;
-  ins::ImuNoise noise_;
-  Vector10 q_ = Vector10::Zero();  // continuous process-noise PSD per state
+  Vector10 q_;  // continuous process-noise PSD per state
+  const std::vector<ImuSample>& slave_imu_;
 };
 
 }  // namespace

@@ -23,11 +23,10 @@
 
 #include "problems/transfer_alignment/config.h"
 #include "problems/transfer_alignment/delay_model.h"
+#include "problems/transfer_alignment/filter_model.h"
 #include "problems/transfer_alignment/inputs.h"
 
 namespace navtwin::transfer {
-
-constexpr int kTransferStates = 10;
 
 /// The filter's estimate after one master record.
 struct TransferEpoch {

@@ -1,0 +1,77 @@
+// What the transfer-alignment filters share (filter.h: the seed's order-1 and order-2
+// forms; history_filter.h: delayed-state fusion): the 10-state error model, its
+// propagation, the initial covariance and process noise from the configuration, the
+// slave position reset from the master, and the walk over the slave IMU that stops at
+// every master record's tag.
+//
+// Error state (true minus estimate):
+//   [0,3) dv_n_mps   slave velocity,  v_true = v + dv
+//   [3,6) phi_n_rad  slave attitude,  R_n_s_true = Exp(phi) R_n_s (core/rotation.h)
+//   [6,9) mu_b_rad   misalignment,    R_b_s_true = Exp(mu) R_b_s (master body axes)
+//   [9]   dtau_s     delay,           tau_true = tau + dtau
+// dv and phi follow the INS error model of problems/ins/error_dynamics.h (its velocity and
+// attitude rows and columns; the position errors are left out because the position is
+// reset from the master at every record, and the slave biases are not states); mu and
+// dtau are random constants with small random walks. Process noise per state (continuous
+// PSD): q_v = VRW^2 + sigma_ba^2 T_b, q_phi = ARW^2 + sigma_bg^2 T_b, where the unestimated
+// bias is covered by white noise whose variance grows like the bias's effect over the
+// filter's memory T_b: sigma_b^2 T_b^2 = q T_b.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/types.h"
+#include "problems/ins/error_dynamics.h"
+#include "problems/transfer_alignment/config.h"
+#include "problems/transfer_alignment/inputs.h"
+#include "problems/transfer_alignment/master.h"
+
+namespace navtwin::transfer {
+
+constexpr int kTransferStates = 10;
+using TransferMatrix = Eigen::Matrix<double, kTransferStates, kTransferStates>;
+using TransferVector = Eigen::Matrix<double, kTransferStates, 1>;
+
+/// Offsets of the error-state blocks.
+namespace tstate {
+constexpr int kVel = 0;
+constexpr int kAtt = 3;
+constexpr int kMis = 6;
+constexpr int kTau = 9;
+}  // namespace tstate
+
+/// Throws std::invalid_argument ("<who>: configuration: ...") for a setting a filter
+/// cannot run with (negative noise, zero initial sigma, ...).
+void CheckTransferFilterConfig(const TransferConfig& config, const char* who);
+
+/// Records in the master-derivative fit window (config.h master_fit_window_s): the window
+/// over the median record spacing, at least 3; 0 (differences) for a zero window.
+int MasterFitRecords(const std::vector<NavState>& master, double window_s);
+
+/// sqrt diag of the initial covariance: initial_velocity, initial_attitude, misalignment, delay.
+TransferVector TransferInitialSigma(const TransferConfig& config);
+
+/// Continuous process-noise PSD per state (header comment).
+TransferVector TransferProcessNoise(const TransferConfig& config);
+
+/// Transition over one IMU sample s from the nominal slave state nav (at the sample's
+/// start): Phi = I + F dt + (F dt)^2 / 2 with F the dv/phi block of ins::ErrorDynamicsF.
+TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s);
+
+/// The slave position set from the master record carried forward over tau with its
+/// velocity (local NED offset v tau on the ellipsoid's radii; metres of error at most,
+/// which the velocity dynamics barely feel).
+void ResetSlavePosition(const NavState& record, double tau_s, NavState* slave);
+
+/// Walks the slave IMU from t0_s: calls propagate(sample) for each sample (or the part of
+/// one up to a master tag inside it) and update(k) for each master record k whose tag lies
+/// in [t0_s, last slave sample], after the slave has been stepped to the tag.
+void WalkSlaveImu(const std::vector<ImuSample>& slave_imu, const MasterStream& master, double t0_s,
+                  const std::function<void(const ImuSample&)>& propagate,
+                  const std::function<void(std::size_t)>& update);
+
+}  // namespace navtwin::transfer
