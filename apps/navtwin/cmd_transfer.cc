@@ -1,8 +1,9 @@
 // navtwin transfer-align: transfer alignment of a slave IMU to a master INS with the
 // misalignment and the transfer delay estimated (seed 002, issue 6;
 // problems/transfer_alignment). Runs order1 (delay compensated with the angular rate
-// only), order2 (angular rate, angular acceleration and acceleration), batch (the Ceres
-// twin) or all three, on recorded files or on a simulated scenario, and prints the slave
+// only), order2 (angular rate, angular acceleration and acceleration), history (the slave's
+// own state at the record's data time, delayed-state fusion), batch (the Ceres twin) or all
+// four, on recorded files or on a simulated scenario, and prints the slave
 // attitude error (roll, pitch, heading RMS / max, mrad) when the truth is known, the delay
 // with its sigma and the misalignment.
 #include <gflags/gflags.h>
@@ -36,13 +37,13 @@ using transfer::TransferResult;
 
 const char* kUsage =
     "navtwin transfer-align --master F --slave_imu F --init_from NAV [--start_s T] [--truth NAV] "
-    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|batch|all [--out DIR [--report]] [--format=json]\n"
+    "[--calibration FILE [--imu_temperature_degC T]] [--config YAML] --method order1|order2|history|batch|all [--out DIR [--report]] [--format=json]\n"
     "       navtwin transfer-align --scenario PRESET|YAML [--seed S] [--delay_s X] [--config YAML] "
-    "--method order1|order2|batch|all [--out DIR [--report]] [--format=json]\n"
+    "--method order1|order2|history|batch|all [--out DIR [--report]] [--format=json]\n"
     "  The slave starts from the record of --init_from at or after --start_s (default: the start of the\n"
     "  slave IMU data), its mounting unknown (identity guess). Attitude errors need --truth (a scenario\n"
     "  brings its own, with the true mounting and delay). Configuration keys: data/configs/\n"
-    "  transfer-alignment-high-maneuver.yaml. --method all runs the three (JSON: an array of three objects).\n"
+    "  transfer-alignment-high-maneuver.yaml. --method all runs the four (JSON: an array of four objects).\n"
     "  --out DIR writes the run folder: summary.json and per method the estimates and attitude errors\n"
     "  against time (docs/run-folder.md).";
 
@@ -53,16 +54,16 @@ int Usage(const std::string& why) {
 
 int RunTransferAlign(const std::vector<std::string>& args) {
   if (!args.empty()) return Usage("unexpected argument '" + args[0] + "'");
-  if (FLAGS_method.empty()) return Usage("--method is required (order1, order2, batch or all)");
+  if (FLAGS_method.empty()) return Usage("--method is required (order1, order2, history, batch or all)");
   if (FLAGS_report && FLAGS_out.empty()) return Usage("--report needs --out DIR (it writes DIR/report.html)");
   std::vector<Method> methods;
   if (FLAGS_method == "all") {
-    methods = {Method::kOrder1, Method::kOrder2, Method::kBatch};
+    methods = {Method::kOrder1, Method::kOrder2, Method::kHistory, Method::kBatch};
   } else {
     try {
       methods = {transfer::ParseMethod(FLAGS_method)};
     } catch (const std::invalid_argument&) {
-      return Usage("--method must be order1, order2, batch or all, got '" + FLAGS_method + "'");
+      return Usage("--method must be order1, order2, history, batch or all, got '" + FLAGS_method + "'");
     }
   }
   const bool scenario = !FLAGS_scenario.empty();
@@ -142,7 +143,7 @@ int RunTransferAlign(const std::vector<std::string>& args) {
 
 Command TransferAlignCommand() {
   return {"transfer-align",
-          "Transfer alignment with misalignment and delay estimation (seed 002): order1, order2 or batch",
+          "Transfer alignment with misalignment and delay estimation (seed 002): order1, order2, history or batch",
           kUsage,
           {"master", "slave_imu", "init_from", "start_s", "truth", "config", "scenario", "seed", "delay_s", "method",
            "calibration", "imu_temperature_degC", "out", "report"},

@@ -41,6 +41,9 @@ struct TransferEpoch {
 struct TransferFilterRun {
   DelayOrder order = DelayOrder::kSecond;
   std::vector<TransferEpoch> epochs;  ///< one per master record inside the slave IMU span
+  /// History filter: records not used because their data time (tag - tau) lay outside the
+  /// slave history kept (before the start, or older than config.history_window_s).
+  std::size_t records_outside_history = 0;
   double run_time_s = 0.0;
 };
 

@@ -46,7 +46,9 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
   r.method = method;
   const auto start = std::chrono::steady_clock::now();
   const TransferFilterRun run =
-      RunTransferFilter(inputs, config, method == Method::kOrder1 ? DelayOrder::kFirst : DelayOrder::kSecond);
+      method == Method::kHistory
+          ? RunHistoryFilter(inputs, config)
+          : RunTransferFilter(inputs, config, method == Method::kOrder1 ? DelayOrder::kFirst : DelayOrder::kSecond);
   r.run_time_s = Seconds(start);
   if (run.epochs.empty()) throw std::runtime_error("the filter made no update (no master record inside the IMU data)");
   const TransferEpoch& last = run.epochs.back();
@@ -63,6 +65,10 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
   for (const TransferEpoch& e : run.epochs) {
     r.estimates.push_back({e.t_s, EulerOf(e.misalignment) * kRadToDeg, e.sigma.segment<3>(6) / kMrad_rad, e.delay_s,
                            e.sigma[9]});
+  }
+  if (run.records_outside_history > 0) {
+    r.note += "; " + std::to_string(run.records_outside_history) + " of " + std::to_string(run.epochs.size()) +
+              " master records not used (data time outside the slave history kept)";
   }
   r.delay_s = last.delay_s;
   r.delay_sigma_s = last.sigma[9];
@@ -102,6 +108,8 @@ const char* MethodName(Method m) {
       return "order1";
     case Method::kOrder2:
       return "order2";
+    case Method::kHistory:
+      return "history";
     case Method::kBatch:
       return "batch";
   }
@@ -109,10 +117,10 @@ const char* MethodName(Method m) {
 }
 
 Method ParseMethod(const std::string& name) {
-  for (const Method m : {Method::kOrder1, Method::kOrder2, Method::kBatch}) {
+  for (const Method m : {Method::kOrder1, Method::kOrder2, Method::kHistory, Method::kBatch}) {
     if (name == MethodName(m)) return m;
   }
-  throw std::invalid_argument("unknown method '" + name + "' (expected order1, order2 or batch)");
+  throw std::invalid_argument("unknown method '" + name + "' (expected order1, order2, history or batch)");
 }
 
 void ScoreAttitude(const TransferInputs& inputs, const std::vector<NavState>& slave_states,

@@ -12,12 +12,13 @@
 #include "problems/transfer_alignment/batch.h"
 #include "problems/transfer_alignment/config.h"
 #include "problems/transfer_alignment/filter.h"
+#include "problems/transfer_alignment/history_filter.h"
 #include "problems/transfer_alignment/inputs.h"
 
 namespace navtwin::transfer {
 
-enum class Method { kOrder1, kOrder2, kBatch };
-const char* MethodName(Method m);  ///< "order1", "order2", "batch"
+enum class Method { kOrder1, kOrder2, kHistory, kBatch };
+const char* MethodName(Method m);  ///< "order1", "order2", "history", "batch"
 Method ParseMethod(const std::string& name);  ///< throws std::invalid_argument listing the names
 
 struct TransferResult {

@@ -84,9 +84,9 @@ TEST(TransferCliTest, ScenarioJsonHasTheIssuesKeys) {
   const RunResult r = Navtwin("transfer-align --scenario " + d + "/short.yaml --seed 1 --delay_s 0.2 --config " + d +
                               "/settle.yaml --method all --format=json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  // An array of the three methods' objects, each starting with the issue's keys in order.
+  // An array of the four methods' objects, each starting with the issue's keys in order.
   EXPECT_EQ(r.out.rfind("[{\"method\":\"order1\",\"roll_rms_mrad\":", 0), 0u) << r.out;
-  for (const char* method : {"order1", "order2", "batch"}) {
+  for (const char* method : {"order1", "order2", "history", "batch"}) {
     const std::string anchor = std::string("{\"method\":\"") + method + "\"";
     ASSERT_NE(r.out.find(anchor), std::string::npos) << method << "\n" << r.out;
     for (const char* key : {"roll_rms_mrad", "pitch_rms_mrad", "heading_rms_mrad", "roll_max_mrad", "pitch_max_mrad",
@@ -109,7 +109,7 @@ std::size_t DataRows(const std::string& text, std::string* header) {
   return rows - 1;
 }
 
-// --out DIR: summary.json with the three methods, per method the estimates against time
+// --out DIR: summary.json with the four methods, per method the estimates against time
 // (a row per update for the filters, per state for the batch, whose one estimate every row
 // repeats) and the attitude errors, with the same last estimate as summary.json; --report
 // adds the page (and needs --out).
@@ -127,7 +127,7 @@ TEST(TransferCliTest, OutWritesTheRunFolder) {
   const std::string summary = ReadAll(out + "/summary.json");
   EXPECT_EQ(summary.rfind("{\"command\":\"transfer-align\",\"methods\":{\"order1\":{\"method\":\"order1\"", 0), 0u)
       << summary;
-  for (const char* method : {"order1", "order2", "batch"}) {
+  for (const char* method : {"order1", "order2", "history", "batch"}) {
     std::string header;
     const std::string estimates = ReadAll(out + "/" + method + "/estimates.csv");
     EXPECT_GT(DataRows(estimates, &header), 10u) << method;

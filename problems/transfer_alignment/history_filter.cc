@@ -1,0 +1,342 @@
+// Delayed-state fusion for transfer alignment (history_filter.h).
+#include "problems/transfer_alignment/history_filter.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "core/rotation.h"
+#include "core/strapdown.h"
+#include "problems/transfer_alignment/filter_model.h"
+#include "problems/transfer_alignment/master.h"
+
+namespace navtwin::transfer {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::MatrixXd;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+using tstate::kAtt;
+using tstate::kMis;
+using tstate::kTau;
+using tstate::kVel;
+
+constexpr int kCloneSize = 6;  // [dv, phi] of the slave at the clone's time
+constexpr int kHistoryIterations = 3;
+// History kept beyond |tau| + 4 sigma_tau: room for the delay to grow before the next trim.
+constexpr double kHistoryMargin_s = 0.1;
+// A delay estimate below zero puts the data time after the present: the measurement is then
+// the slave's newest IMU interval extrapolated (the linearisation of the model about the
+// present), up to this lead; further, the record is not used.
+constexpr double kMaxLead_s = 0.5;
+
+/// Position of s in a sorted sequence of times: the segment [i0, i0 + 1] that holds s, or
+/// the first / last segment when s is outside (the caller extrapolates).
+template <typename Times>
+std::size_t Segment(const Times& times, double s) {
+  const auto it = std::upper_bound(times.begin(), times.end(), s);
+  const std::size_t j = static_cast<std::size_t>(it - times.begin());
+  return std::min(std::max<std::size_t>(j, 1), times.size() - 1) - 1;
+}
+
+class HistoryFilter {
+ public:
+  HistoryFilter(const TransferInputs& in, const TransferConfig& cfg)
+      : cfg_(cfg),
+        master_(in.master, DerivativeMode::kCausal, in.master_path,
+                MasterFitRecords(in.master, cfg.master_fit_window_s)),
+        ins_(in.slave_initial),
+        q_(TransferProcessNoise(cfg)),
+        slave_imu_(in.slave_imu) {
+    CheckTransferFilterConfig(cfg, "RunHistoryFilter");
+    misalignment_ = in.misalignment_guess.normalized();
+    tau_s_ = cfg.delay_initial_s;
+    P_ = MatrixXd(TransferInitialSigma(cfg).cwiseAbs2().asDiagonal());
+    phi_acc_.setIdentity();
+    PushNode();
+    AddClone();
+  }
+
+  void Run(TransferFilterRun* out) {
+    WalkSlaveImu(
+        slave_imu_, master_, ins_.state().t_s, [this](const ImuSample& s) { Propagate(s); },
+        [this, out](std::size_t k) { Update(k, out); });
+  }
+
+ private:
+  std::size_t clones() const { return clone_t_.size(); }
+  static int CloneOffset(std::size_t j) { return kTransferStates + kCloneSize * static_cast<int>(j); }
+
+  void PushNode() {
+    const NavState& s = ins_.state();
+    node_t_.push_back(s.t_s);
+    nodes_.push_back({s.t_s, s.q_n_b, s.v_n_mps});
+  }
+
+  void Propagate(const ImuSample& s) {
+    const TransferMatrix Phi = TransferTransition(ins_.state(), s);
+    auto Pxx = P_.topLeftCorner<kTransferStates, kTransferStates>();
+    Pxx = Phi * Pxx * Phi.transpose();
+    Pxx.diagonal() += q_ * s.dt_s;
+    phi_acc_ = Phi * phi_acc_;
+    ins_.Update(s);
+    PushNode();
+  }
+
+  /// Applies the transition accumulated since the last update to the present-clone
+  /// cross-covariance.
+  void FlushCrossCovariance() {
+    const int n = kCloneSize * static_cast<int>(clones());
+    if (n > 0 && !phi_acc_.isIdentity(0.0)) {
+      P_.topRightCorner(kTransferStates, n) = phi_acc_ * P_.topRightCorner(kTransferStates, n);
+      P_.bottomLeftCorner(n, kTransferStates) = P_.topRightCorner(kTransferStates, n).transpose();
+    }
+    phi_acc_.setIdentity();
+  }
+
+  /// Clones the present's [dv, phi] at its time (unless the newest clone is at that time).
+  void AddClone() {
+    if (!clone_t_.empty() && clone_t_.back() >= ins_.state().t_s) return;
+    const int N = static_cast<int>(P_.rows());
+    MatrixXd P(N + kCloneSize, N + kCloneSize);
+    P.topLeftCorner(N, N) = P_;
+    P.bottomLeftCorner(kCloneSize, N) = P_.topRows(kCloneSize);
+    P.topRightCorner(N, kCloneSize) = P_.leftCols(kCloneSize);
+    P.bottomRightCorner<kCloneSize, kCloneSize>() = P_.topLeftCorner<kCloneSize, kCloneSize>();
+    P_.swap(P);
+    clone_t_.push_back(ins_.state().t_s);
+  }
+
+  /// Drops the clones (and nominal epochs) older than the history the delay needs, keeping
+  /// the newest one at or before that horizon.
+  void Trim(double t_now_s) {
+    const double sigma_tau = std::sqrt(std::max(P_(kTau, kTau), 0.0));
+    const double span = std::min(cfg_.history_window_s, std::max(tau_s_, 0.0) + 4.0 * sigma_tau + kHistoryMargin_s);
+    const double horizon = t_now_s - span;
+    std::size_t drop = 0;
+    while (drop + 1 < clones() && clone_t_[drop + 1] <= horizon) ++drop;
+    if (drop > 0) {
+      const int n_old = kCloneSize * static_cast<int>(drop);
+      const int keep = static_cast<int>(P_.rows()) - kTransferStates - n_old;
+      MatrixXd P(kTransferStates + keep, kTransferStates + keep);
+      P.topLeftCorner<kTransferStates, kTransferStates>() = P_.topLeftCorner<kTransferStates, kTransferStates>();
+      P.topRightCorner(kTransferStates, keep) = P_.topRightCorner(kTransferStates, keep);
+      P.bottomLeftCorner(keep, kTransferStates) = P_.bottomLeftCorner(keep, kTransferStates);
+      P.bottomRightCorner(keep, keep) = P_.bottomRightCorner(keep, keep);
+      P_.swap(P);
+      clone_t_.erase(clone_t_.begin(), clone_t_.begin() + static_cast<std::ptrdiff_t>(drop));
+    }
+    const double oldest = clone_t_.front();
+    while (node_t_.size() > 2 && node_t_[1] <= oldest) {
+      node_t_.pop_front();
+      nodes_.pop_front();
+    }
+  }
+
+  /// The bracket at data time s under the augmented correction dx (errors of the nodes),
+  /// with the augmented offsets of its two error nodes; false when s is outside the history.
+  bool Bracket(double s, const VectorXd& dx, HistoryBracket* b, int* o0, int* o1) const {
+    const double t_now = ins_.state().t_s;
+    if (s < clone_t_.front() || s > t_now + kMaxLead_s || nodes_.size() < 2) return false;
+    const std::size_t i = Segment(node_t_, s);
+    b->n0 = nodes_[i];
+    b->n1 = nodes_[i + 1];
+    // Error nodes: the clones, then the present.
+    const std::size_t j = static_cast<std::size_t>(std::upper_bound(clone_t_.begin(), clone_t_.end(), s) - clone_t_.begin());
+    if (j >= clones()) {  // after the newest clone
+      b->c0_s = clone_t_.back();
+      b->c1_s = t_now;
+      *o0 = CloneOffset(clones() - 1);
+      *o1 = 0;
+    } else {
+      b->c0_s = clone_t_[j - 1];
+      b->c1_s = clone_t_[j];
+      *o0 = CloneOffset(j - 1);
+      *o1 = CloneOffset(j);
+    }
+    if (!(b->c1_s > b->c0_s)) return false;  // a record at the newest clone's time, before any propagation
+    b->e0 = dx.segment<kCloneSize>(*o0);
+    b->e1 = dx.segment<kCloneSize>(*o1);
+    return true;
+  }
+
+  void Update(std::size_t k, TransferFilterRun* out) {
+    FlushCrossCovariance();
+    const MasterKinematics& kin = master_.kinematics(k);
+    Trim(kin.tag_s);
+    NavState s = ins_.state();
+    ResetSlavePosition(master_.record(k), tau_s_, &s);
+    ins_.SetState(s);
+    Eigen::Matrix<double, 6, 1> r0;
+    const bool used = Correct(kin, &r0);
+    if (!used) ++out->records_outside_history;
+    AddClone();
+    TransferEpoch e;
+    e.t_s = kin.tag_s;
+    e.slave = ins_.state();
+    e.slave.t_s = kin.tag_s;
+    e.misalignment = misalignment_;
+    e.delay_s = tau_s_;
+    e.sigma = P_.diagonal().head<kTransferStates>().cwiseMax(0.0).cwiseSqrt();
+    e.innovation = used ? Eigen::Matrix<double, 6, 1>(-r0) : Eigen::Matrix<double, 6, 1>::Constant(std::nan(""));
+    out->epochs.push_back(e);
+  }
+
+  /// The iterated update with record kin (history_filter.h); r0: the residual at the prior
+  /// estimate. False (nothing changed) when the data time lies outside the history.
+  bool Correct(const MasterKinematics& kin, Eigen::Matrix<double, 6, 1>* r0) {
+    const int N = static_cast<int>(P_.rows());
+    const Vector6 inv_sigma = (Vector6() << Vector3d::Constant(cfg_.master_velocity_mps),
+                               Vector3d::Constant(cfg_.master_attitude_rad))
+                                  .finished()
+                                  .cwiseInverse();
+    VectorXd dx = VectorXd::Zero(N);
+    MatrixXd PHt(N, 6);
+    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> S;
+    Vector6 y;
+    for (int it = 0; it < kHistoryIterations; ++it) {
+      const double tau_i = tau_s_ + dx(kTau);
+      HistoryBracket b;
+      int o0 = 0, o1 = 0;
+      if (!Bracket(kin.tag_s - tau_i, dx, &b, &o0, &o1)) {
+        if (it == 0) return false;
+        break;  // the iterate left the history: keep the previous linearisation
+      }
+      const Matrix3d M_i = ApplyAttitudeError<double>(Vector3d(dx.segment<3>(kMis)), misalignment_).toRotationMatrix();
+      Vector6 r;
+      Eigen::Matrix<double, 6, kHistoryColumns> H;
+      HistoryMatchResidualAndJacobian(b, M_i, kin, tau_i, cfg_.lever_arm_b_m, &r, &H);
+      if (it == 0) *r0 = r;
+      H = inv_sigma.asDiagonal() * H;
+      const int idx[4] = {o0, o1, kMis, kTau};
+      const int len[4] = {kCloneSize, kCloneSize, 3, 1};
+      PHt.setZero();
+      y = -r.cwiseProduct(inv_sigma);
+      for (int g = 0, col = 0; g < 4; col += len[g], ++g) {
+        PHt.noalias() += P_.middleCols(idx[g], len[g]) * H.middleCols(col, len[g]).transpose();
+        y += H.middleCols(col, len[g]) * dx.segment(idx[g], len[g]);
+      }
+      Eigen::Matrix<double, 6, 6> HPHt = Eigen::Matrix<double, 6, 6>::Identity();
+      for (int g = 0, col = 0; g < 4; col += len[g], ++g) HPHt.noalias() += H.middleCols(col, len[g]) * PHt.middleRows(idx[g], len[g]);
+      S.compute(HPHt);
+      dx = PHt * S.solve(y);
+      if (!dx.allFinite()) Fail(kin.tag_s, "the iterated correction");
+    }
+    // P <- P - K S K^T with K = P H^T S^-1 (the last linearisation).
+    const MatrixXd K = PHt * S.solve(Eigen::Matrix<double, 6, 6>::Identity());
+    P_.noalias() -= K * PHt.transpose();
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    Feedback(dx, kin.tag_s);
+    return true;
+  }
+
+  /// The correction into the present, the misalignment, the delay and the stored history
+  /// (each nominal epoch by its error interpolated between the error nodes around it).
+  void Feedback(const VectorXd& dx, double t_s) {
+    NavState s = ins_.state();
+    s.v_n_mps += dx.segment<3>(kVel);
+    s.q_n_b = ApplyAttitudeError<double>(Vector3d(dx.segment<3>(kAtt)), s.q_n_b);
+    misalignment_ = ApplyAttitudeError<double>(Vector3d(dx.segment<3>(kMis)), misalignment_);
+    tau_s_ += dx(kTau);
+    if (!s.v_n_mps.allFinite() || !s.q_n_b.coeffs().allFinite() || !std::isfinite(tau_s_)) Fail(t_s, "the slave state");
+    ins_.SetState(s);
+    const auto node_error = [&](std::size_t j) -> Vector6 {
+      return j < clones() ? Vector6(dx.segment<kCloneSize>(CloneOffset(j))) : Vector6(dx.head<kCloneSize>());
+    };
+    std::size_t j = 0;  // error node at or after the epoch (clones(): the present)
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+      SlaveNode& n = nodes_[i];
+      while (j < clones() && clone_t_[j] < n.t_s) ++j;
+      Vector6 e;
+      if (j == 0) {
+        e = node_error(0);
+      } else {
+        const double c0 = clone_t_[j - 1], c1 = j < clones() ? clone_t_[j] : s.t_s;
+        const double a = c1 > c0 ? (n.t_s - c0) / (c1 - c0) : 1.0;
+        e = (1.0 - a) * node_error(j - 1) + a * node_error(j);
+      }
+      n.v_n_mps += e.head<3>();
+      n.q_n_s = ApplyAttitudeError<double>(Vector3d(e.tail<3>()), n.q_n_s);
+    }
+    nodes_.back() = {s.t_s, s.q_n_b, s.v_n_mps};
+  }
+
+  [[noreturn]] static void Fail(double t_s, const char* what) {
+    std::ostringstream m;
+    m << "RunHistoryFilter: " << what << " became non-finite at t = " << t_s << " s";
+    throw std::runtime_error(m.str());
+  }
+
+  const TransferConfig& cfg_;
+  MasterStream master_;
+  Strapdown ins_;
+  Eigen::Quaterniond misalignment_;
+  double tau_s_ = 0.0;
+  TransferVector q_;  // continuous process-noise PSD per state
+  const std::vector<ImuSample>& slave_imu_;
+  MatrixXd P_;                 // [present (10), clone 0 (6), clone 1 (6), ...]
+  TransferMatrix phi_acc_;     // transition since the last update (not yet in the cross blocks)
+  std::deque<double> clone_t_;
+  std::deque<double> node_t_;  // times of nodes_, for the searches
+  std::deque<SlaveNode> nodes_;
+};
+
+}  // namespace
+
+void HistoryMatchResidualAndJacobian(const HistoryBracket& b, const Matrix3d& R_b_s, const MasterKinematics& m,
+                                     double tau_s, const Vector3d& lever_arm_b_m, Eigen::Matrix<double, 6, 1>* r,
+                                     Eigen::Matrix<double, 6, kHistoryColumns>* H) {
+  const double s = m.tag_s - tau_s;
+  const double h = b.n1.t_s - b.n0.t_s;
+  const double hc = b.c1_s - b.c0_s;
+  if (!(h > 0.0) || !(hc > 0.0)) throw std::invalid_argument("HistoryMatchResidualAndJacobian: empty bracket");
+  // Nominal at s: linear velocity, geodesic attitude R0 Exp(a omega h).
+  const double a = (s - b.n0.t_s) / h;
+  const Matrix3d R0 = b.n0.q_n_s.toRotationMatrix();
+  const Vector3d omega_s = LogSO3<double>(Matrix3d(R0.transpose() * b.n1.q_n_s.toRotationMatrix())) / h;
+  const Vector3d accel_n = (b.n1.v_n_mps - b.n0.v_n_mps) / h;
+  // Error at s, linear between the error nodes.
+  const double ac = (s - b.c0_s) / hc;
+  const Vector6 e = b.e0 + ac * (b.e1 - b.e0);
+  const Matrix3d R_s = ExpSO3<double>(Vector3d(e.tail<3>())) * R0 * ExpSO3<double>(Vector3d(omega_s * (a * h)));
+  const Vector3d v_s = b.n0.v_n_mps + a * h * accel_n + e.head<3>();
+  // The shared model with no carry: the master at its data time.
+  Eigen::Matrix<double, 6, kTransferStates> H10;
+  MatchResidualAndJacobian(R_s, v_s, R_b_s, m, 0.0, DelayOrder::kFirst, lever_arm_b_m, r, &H10);
+  // [dv, phi] at s; phi enters as Exp(phi) R, so d/d phi of Exp(phi + d) = Exp(Jl(phi) d) Exp(phi).
+  Eigen::Matrix<double, 6, 6> H_e = H10.leftCols<6>();
+  H_e.rightCols<3>() = H_e.rightCols<3>() * RightJacobianSO3<double>(Vector3d(-e.tail<3>()));
+  H->setZero();
+  H->leftCols<6>() = (1.0 - ac) * H_e;
+  H->middleCols<6>(6) = ac * H_e;
+  H->middleCols<3>(12) = H10.middleCols<3>(kMis);
+  // d/dtau (ds/dtau = -1): the error interpolation, the nominal velocity, and the nominal
+  // attitude R(s - d) = R(s) Exp(-omega d), which makes E = R_s M^T C^T into E Exp(-C M omega d).
+  const Vector6 de_dtau = -(b.e1 - b.e0) / hc;
+  Vector6 h_tau = H_e * de_dtau;
+  h_tau.head<3>() -= accel_n;
+  const Matrix3d C = m.q_n_b.toRotationMatrix();
+  h_tau.tail<3>() -= RightJacobianInverseSO3<double>(Vector3d(r->tail<3>())) * (C * R_b_s * omega_s);
+  H->col(15) = h_tau;
+}
+
+TransferFilterRun RunHistoryFilter(const TransferInputs& inputs, const TransferConfig& config) {
+  const auto start = std::chrono::steady_clock::now();
+  ValidateInputs(inputs);
+  TransferFilterRun run;
+  HistoryFilter filter(inputs, config);
+  filter.Run(&run);
+  run.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+}  // namespace navtwin::transfer
