@@ -309,6 +309,7 @@ void TransferBatch::Covariance(TransferBatchSolution* out) {
   const Eigen::MatrixXd& P = *c.covariance;
   out->misalignment_sigma_rad = P.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
   out->delay_sigma_s = std::sqrt(std::max(0.0, P(3, 3)));
+  out->misalignment_delay_covariance = P.topLeftCorner<4, 4>();
 }
 
 TransferBatchSolution TransferBatch::Run() {

@@ -30,6 +30,8 @@ struct TransferBatchSolution {
   Eigen::Vector3d misalignment_sigma_rad = Eigen::Vector3d::Zero();  ///< tangent (master body) axes
   double delay_s = 0.0;
   double delay_sigma_s = 0.0;
+  /// Joint covariance of [mu (3, tangent), tau].
+  Eigen::Matrix4d misalignment_delay_covariance = Eigen::Matrix4d::Zero();
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
   std::vector<NavState> states;  ///< the smoothed slave states (attitude R_n_s)

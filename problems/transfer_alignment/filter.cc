@@ -67,6 +67,8 @@ class TransferFilter {
     tau_s_ = cfg.delay_initial_s;
   }
 
+  const Eigen::MatrixXd& P() const { return kf_.P(); }
+
   void Run(TransferFilterRun* out) {
     WalkSlaveImu(
         slave_imu_, master_, ins_.state().t_s, [this](const ImuSample& s) { Propagate(s); },
@@ -242,6 +244,7 @@ TransferFilterRun RunTransferFilter(const TransferInputs& inputs, const Transfer
   run.order = order;
   TransferFilter filter(inputs, config, order);
   filter.Run(&run);
+  run.misalignment_delay_covariance = filter.P().block<4, 4>(kMis, kMis);
   run.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;
 }

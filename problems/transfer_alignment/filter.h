@@ -16,6 +16,7 @@
 // on misalignment and delay (flexure, clock wander; configurable).
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include <Eigen/Core>
@@ -44,6 +45,8 @@ struct TransferFilterRun {
   /// History filter: records not used because their data time (tag - tau) lay outside the
   /// slave history kept (before the start, or older than config.history_window_s).
   std::size_t records_outside_history = 0;
+  /// After the last update: the joint covariance of [mu (3), dtau].
+  Eigen::Matrix4d misalignment_delay_covariance = Eigen::Matrix4d::Zero();
   double run_time_s = 0.0;
 };
 

@@ -32,6 +32,9 @@ using tstate::kVel;
 
 constexpr int kCloneSize = 6;  // [dv, phi] of the slave at the clone's time
 constexpr int kHistoryIterations = 3;
+// Spacing of the clones (s): the error between two clones is interpolated linearly, and the
+// error state changes little over it (f x phi dt: 50 m/s^2 x 0.1 mrad x 0.05 s = 0.25 mm/s).
+constexpr double kCloneSpacing_s = 0.05;
 // History kept beyond |tau| + 4 sigma_tau: room for the delay to grow before the next trim.
 constexpr double kHistoryMargin_s = 0.1;
 // A delay estimate below zero puts the data time after the present: the measurement is then
@@ -65,6 +68,8 @@ class HistoryFilter {
     PushNode();
     AddClone();
   }
+
+  const MatrixXd& P() const { return P_; }
 
   void Run(TransferFilterRun* out) {
     WalkSlaveImu(
@@ -105,7 +110,7 @@ class HistoryFilter {
 
   /// Clones the present's [dv, phi] at its time (unless the newest clone is at that time).
   void AddClone() {
-    if (!clone_t_.empty() && clone_t_.back() >= ins_.state().t_s) return;
+    if (!clone_t_.empty() && clone_t_.back() > ins_.state().t_s - kCloneSpacing_s + 1e-9) return;
     const int N = static_cast<int>(P_.rows());
     MatrixXd P(N + kCloneSize, N + kCloneSize);
     P.topLeftCorner(N, N) = P_;
@@ -163,7 +168,12 @@ class HistoryFilter {
       *o0 = CloneOffset(j - 1);
       *o1 = CloneOffset(j);
     }
-    if (!(b->c1_s > b->c0_s)) return false;  // a record at the newest clone's time, before any propagation
+    if (!(b->c1_s > b->c0_s)) {
+      // The present still at the newest clone's time (no IMU sample since): the two are the
+      // same state, so any split of the weight between them gives the same error; 1 s apart
+      // puts it on the present.
+      b->c0_s = b->c1_s - 1.0;
+    }
     b->e0 = dx.segment<kCloneSize>(*o0);
     b->e1 = dx.segment<kCloneSize>(*o1);
     return true;
@@ -201,7 +211,7 @@ class HistoryFilter {
                                   .cwiseInverse();
     VectorXd dx = VectorXd::Zero(N);
     MatrixXd PHt(N, 6);
-    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> S;
+    Eigen::LLT<Eigen::Matrix<double, 6, 6>> S;  // of H P H^T + I (whitened)
     Vector6 y;
     for (int it = 0; it < kHistoryIterations; ++it) {
       const double tau_i = tau_s_ + dx(kTau);
@@ -231,10 +241,11 @@ class HistoryFilter {
       dx = PHt * S.solve(y);
       if (!dx.allFinite()) Fail(kin.tag_s, "the iterated correction");
     }
-    // P <- P - K S K^T with K = P H^T S^-1 (the last linearisation).
-    const MatrixXd K = PHt * S.solve(Eigen::Matrix<double, 6, 6>::Identity());
-    P_.noalias() -= K * PHt.transpose();
-    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    // P <- P - K S K^T with K = P H^T S^-1 (the last linearisation): K S K^T = W W^T with
+    // W = P H^T L^-T, S = L L^T; updated on the lower triangle, then mirrored.
+    const MatrixXd W = S.matrixL().solve(PHt.transpose()).transpose();
+    P_.selfadjointView<Eigen::Lower>().rankUpdate(W, -1.0);
+    P_.triangularView<Eigen::StrictlyUpper>() = P_.transpose();
     Feedback(dx, kin.tag_s);
     return true;
   }
@@ -335,6 +346,7 @@ TransferFilterRun RunHistoryFilter(const TransferInputs& inputs, const TransferC
   TransferFilterRun run;
   HistoryFilter filter(inputs, config);
   filter.Run(&run);
+  run.misalignment_delay_covariance = filter.P().block<4, 4>(kMis, kMis);
   run.run_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return run;
 }

@@ -19,6 +19,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/Cholesky>
+
 #include "core/io/json_writer.h"
 #include "core/rotation.h"
 #include "problems/ins/nav_error.h"
@@ -40,6 +42,18 @@ std::optional<Eigen::Quaterniond> TruthAttitudeAt(const std::vector<NavState>& t
 }
 
 Eigen::Vector3d EulerOf(const Eigen::Quaterniond& q) { return EulerFromDcm(Eigen::Matrix3d(q.toRotationMatrix())); }
+
+/// The covariance of [mu, tau] and, with the true misalignment and delay, its NEES.
+void ScoreConsistency(const TransferInputs& inputs, const Eigen::Quaterniond& misalignment_est, double delay_s,
+                      const Eigen::Matrix4d& P, TransferResult* r) {
+  r->misalignment_delay_covariance = P;
+  if (!inputs.true_misalignment || !inputs.true_delay_s) return;
+  Eigen::Vector4d e;
+  e.head<3>() = LogSO3(Eigen::Matrix3d((*inputs.true_misalignment * misalignment_est.conjugate()).toRotationMatrix()));
+  e(3) = *inputs.true_delay_s - delay_s;
+  const Eigen::LDLT<Eigen::Matrix4d> ldlt(P);
+  if (ldlt.info() == Eigen::Success && ldlt.isPositive()) r->nees_misalignment_delay = e.dot(ldlt.solve(e));
+}
 
 TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfig& config, Method method) {
   TransferResult r;
@@ -74,6 +88,7 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
   r.delay_sigma_s = last.sigma[9];
   r.misalignment_deg = EulerOf(last.misalignment) * kRadToDeg;
   r.misalignment_sigma_mrad = last.sigma.segment<3>(6) / kMrad_rad;
+  ScoreConsistency(inputs, last.misalignment, last.delay_s, run.misalignment_delay_covariance, &r);
   return r;
 }
 
@@ -90,6 +105,7 @@ TransferResult RunBatchMethod(const TransferInputs& inputs, const TransferConfig
   r.delay_sigma_s = sol.delay_sigma_s;
   r.misalignment_deg = EulerOf(sol.misalignment) * kRadToDeg;
   r.misalignment_sigma_mrad = sol.misalignment_sigma_rad / kMrad_rad;
+  ScoreConsistency(inputs, sol.misalignment, sol.delay_s, sol.misalignment_delay_covariance, &r);
   for (const NavState& state : sol.states) {
     r.estimates.push_back({state.t_s, r.misalignment_deg, r.misalignment_sigma_mrad, r.delay_s, r.delay_sigma_s});
   }
@@ -200,6 +216,7 @@ std::string TransferResultJson(const TransferResult& r) {
   vec("misalignment_sigma_mrad", r.misalignment_sigma_mrad);
   vec("misalignment_true_deg", r.misalignment_true_deg);
   w.Field("misalignment_error_mrad", r.misalignment_error_mrad)
+      .Field("nees_misalignment_delay", r.nees_misalignment_delay)
       .Field("epochs", r.t_s.size())
       .Field("note", r.note)
       .EndObject();
@@ -237,6 +254,11 @@ std::string TransferResultTable(const TransferResult& r) {
                 cell(r.misalignment_true_deg.x(), "%.4f").c_str(), cell(r.misalignment_true_deg.y(), "%.4f").c_str(),
                 cell(r.misalignment_true_deg.z(), "%.4f").c_str(), cell(r.misalignment_error_mrad, "%.3f").c_str());
   out << line;
+  if (!std::isnan(r.nees_misalignment_delay)) {
+    std::snprintf(line, sizeof line, "  NEES of (misalignment, delay) %.2f (chi-square, 4 degrees of freedom: 95 %% below 9.49)\n",
+                  r.nees_misalignment_delay);
+    out << line;
+  }
   std::snprintf(line, sizeof line, "  run time %.3f s, %zu epochs with truth (RMS / max after settle_s)\n", r.run_time_s, r.t_s.size());
   out << line;
   if (!r.note.empty()) out << "  note: " << r.note << "\n";

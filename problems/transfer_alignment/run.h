@@ -33,6 +33,11 @@ struct TransferResult {
   Eigen::Vector3d misalignment_deg = Eigen::Vector3d::Zero();  ///< R_b_s as ZYX Euler (roll, pitch, yaw)
   Eigen::Vector3d misalignment_sigma_mrad = Eigen::Vector3d::Zero();
   double misalignment_error_mrad = std::nan("");  ///< |Log(R_true R_est^T)| when known
+  /// Joint covariance of [mu (3, master body tangent, rad), tau (s)] of the final estimate.
+  Eigen::Matrix4d misalignment_delay_covariance = Eigen::Matrix4d::Zero();
+  /// e^T P^-1 e of e = [Log(M_true M_est^T), tau_true - tau_est] with the covariance above
+  /// (chi-square with 4 degrees of freedom when the estimate is consistent); NaN without truth.
+  double nees_misalignment_delay = std::nan("");
   Eigen::Vector3d misalignment_true_deg = Eigen::Vector3d::Constant(std::nan(""));  ///< when known
   double delay_true_s = std::nan("");  ///< when known
   /// What the errors were scored against ("slave truth", "body truth: ..."), or why not.
