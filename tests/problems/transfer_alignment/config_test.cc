@@ -29,6 +29,7 @@ lever_arm_b_m: [1.5, -0.5, 0.25]
 settle_s: 0
 batch_state_interval_s: 0.2
 batch_max_iterations: 12
+history_window_s: 2.5
 )";
 
 TEST(TransferConfigTest, EveryKeyIsRead) {
@@ -48,6 +49,7 @@ TEST(TransferConfigTest, EveryKeyIsRead) {
   EXPECT_EQ(c.settle_s, 0.0);  // 0 is allowed: score from the start
   EXPECT_EQ(c.batch_state_interval_s, 0.2);
   EXPECT_EQ(c.batch_max_iterations, 12);
+  EXPECT_EQ(c.history_window_s, 2.5);
 }
 
 TEST(TransferConfigTest, EmptyTextGivesTheDefaults) {
@@ -80,6 +82,7 @@ TEST(TransferConfigTest, ShippedPresetFileListsEveryKeyWithTheDefaults) {
   EXPECT_EQ(c.settle_s, d.settle_s);
   EXPECT_EQ(c.batch_state_interval_s, d.batch_state_interval_s);
   EXPECT_EQ(c.batch_max_iterations, d.batch_max_iterations);
+  EXPECT_EQ(c.history_window_s, d.history_window_s);
 }
 
 /// Parses `text` expecting an InputError; returns it.
@@ -114,7 +117,7 @@ TEST(TransferConfigTest, ValuesOutOfRangeNameTheKeyAndLine) {
       {"settle_s", "-1"},             {"batch_state_interval_s", "0"}, {"batch_max_iterations", "0"},
       {"gyro_bias_deg_h", "-1"},      {"gyro_arw_deg_sqrt_h", "-0.1"}, {"accel_bias_ug", "-5"},
       {"accel_vrw_m_s_sqrt_h", "-1"}, {"delay_s", "abc"},              {"lever_arm_b_m", "[1, 2]"},
-      {"batch_max_iterations", "2.5"}};
+      {"batch_max_iterations", "2.5"}, {"history_window_s", "0"}};
   for (const Case& c : cases) {
     const std::string text = std::string("delay_initial_s: 0.1\n") + c.key + ": " + c.value + "\n";
     const InputError e = ErrorOf(text);
