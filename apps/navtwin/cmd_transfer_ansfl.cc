@@ -38,7 +38,7 @@ using transfer::AnsflAlignment;
 using transfer::Method;
 
 const char* kUsage =
-    "navtwin transfer-align-ansfl --data DIR [--method order2|batch] [--config YAML] [--csv F] [--format=json]\n"
+    "navtwin transfer-align-ansfl --data DIR [--method order2|history|batch] [--config YAML] [--csv F] [--format=json]\n"
     "                             [--path TYPE/path_N [--dot K [--calibration_out FILE]]]\n"
     "  DIR: the ansfl-quadrotor folder (StraightLine/path_*, Horizontal/path_*). Default method order2;\n"
     "  default configuration: the DOT slave against the DJI master (docs/transfer-alignment-real.md).\n"
@@ -205,10 +205,10 @@ int RunTransferAlignAnsfl(const std::vector<std::string>& args) {
     try {
       method = transfer::ParseMethod(FLAGS_method);
     } catch (const std::invalid_argument&) {
-      return Usage("--method must be order2 or batch, got '" + FLAGS_method + "'");
+      return Usage("--method must be order2, history or batch, got '" + FLAGS_method + "'");
     }
     if (method == Method::kOrder1)
-      return Usage("--method must be order2 or batch (order1 is the seed's baseline only)");
+      return Usage("--method must be order2, history or batch (order1 is the seed's baseline only)");
   }
   const transfer::TransferConfig config =
       FLAGS_config.empty() ? transfer::AnsflDotConfig() : transfer::LoadTransferConfig(FLAGS_config);
