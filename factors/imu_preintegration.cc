@@ -27,6 +27,7 @@ struct ImuFactorData {
   Eigen::Vector3d delta_v = Eigen::Vector3d::Zero(), delta_p = Eigen::Vector3d::Zero();
   Eigen::Matrix3d J_R_bg, J_v_bg, J_v_ba, J_p_bg, J_p_ba;
   Eigen::Matrix3d J_R_sg, J_v_sg, J_p_sg, J_v_sa, J_p_sa;
+  Eigen::Matrix<double, 9, 6> J_mg = Eigen::Matrix<double, 9, 6>::Zero(), J_ma = Eigen::Matrix<double, 9, 6>::Zero();
   ImuErrors lin;
   Matrix9d sqrt_information = Matrix9d::Identity();  // S = L^-1
   bool whiten = true;
@@ -51,6 +52,8 @@ ImuFactorData MakeData(const ImuPreintegration& pre, bool whiten) {
   d.J_p_sg = pre.J_p_sg();
   d.J_v_sa = pre.J_v_sa();
   d.J_p_sa = pre.J_p_sa();
+  d.J_mg = pre.J_mg();
+  d.J_ma = pre.J_ma();
   d.lin = pre.lin();
   d.whiten = whiten;
   if (whiten) d.sqrt_information = pre.SqrtInformation();
@@ -85,13 +88,16 @@ class ImuFactor {
   template <typename T>
   bool operator()(const T* pos_i, const T* vel_i, const T* q_i, const T* bg_i, const T* ba_i, const T* pos_j,
                   const T* vel_j, const T* q_j, T* residual) const {
-    return Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, nullptr, nullptr, pos_j, vel_j, q_j, residual);
+    return Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, nullptr, nullptr, nullptr, nullptr, pos_j, vel_j, q_j,
+                       residual);
   }
 
-  /// sg_i, sa_i null: the scale factors at the linearisation point.
+  /// sg_i, sa_i null: the scale factors at the linearisation point; mg_i, ma_i null: no
+  /// axis misalignment.
   template <typename T>
   bool Evaluate(const T* pos_i, const T* vel_i, const T* q_i_ptr, const T* bg_i, const T* ba_i, const T* sg_i,
-                const T* sa_i, const T* pos_j, const T* vel_j, const T* q_j_ptr, T* residual_ptr) const {
+                const T* sa_i, const T* mg_i, const T* ma_i, const T* pos_j, const T* vel_j, const T* q_j_ptr,
+                T* residual_ptr) const {
     const T dt(d_.dt_s);
     const Eigen::Map<const Vector3<T>> v_i(vel_i), v_j(vel_j);
     const Quaternion<T> q_i = Eigen::Map<const Quaternion<T>>(q_i_ptr).normalized();
@@ -109,6 +115,13 @@ class ImuFactor {
       dphi += d_.J_R_sg.cast<T>() * dsg;
       dv += d_.J_v_sg.cast<T>() * dsg + d_.J_v_sa.cast<T>() * dsa;
       dp += d_.J_p_sg.cast<T>() * dsg + d_.J_p_sa.cast<T>() * dsa;
+    }
+    if (mg_i != nullptr) {
+      const Eigen::Map<const Eigen::Matrix<T, 6, 1>> mg(mg_i), ma(ma_i);
+      const Eigen::Matrix<T, 9, 1> d_mis = d_.J_mg.cast<T>() * mg + d_.J_ma.cast<T>() * ma;
+      dphi += d_mis.template segment<3>(0);
+      dv += d_mis.template segment<3>(3);
+      dp += d_mis.template segment<3>(6);
     }
     const Quaternion<T> dq = d_.delta_q.cast<T>() * QuatFromRotVec<T>(dphi);
 
@@ -167,12 +180,42 @@ class ImuScaleFactor {
   template <typename T>
   bool operator()(const T* pos_i, const T* vel_i, const T* q_i, const T* bg_i, const T* ba_i, const T* sg_i,
                   const T* sa_i, const T* pos_j, const T* vel_j, const T* q_j, T* residual) const {
-    return factor_.Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, pos_j, vel_j, q_j, residual);
+    return factor_.Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, nullptr, nullptr, pos_j, vel_j, q_j,
+                               residual);
   }
 
  private:
   ImuFactor factor_;
 };
+
+/// The factor with the scale-factor and axis-misalignment blocks (CreateImuInstrumentFactor).
+class ImuInstrumentFactor {
+ public:
+  explicit ImuInstrumentFactor(ImuFactorData data) : factor_(std::move(data)) {}
+
+  template <typename T>
+  bool operator()(const T* pos_i, const T* vel_i, const T* q_i, const T* bg_i, const T* ba_i, const T* sg_i,
+                  const T* sa_i, const T* mg_i, const T* ma_i, const T* pos_j, const T* vel_j, const T* q_j,
+                  T* residual) const {
+    return factor_.Evaluate<T>(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, mg_i, ma_i, pos_j, vel_j, q_j, residual);
+  }
+
+ private:
+  ImuFactor factor_;
+};
+
+/// d a / d mg at zero misalignment for a corrected increment a (header comment): column
+/// (i, j) is a_j e_i, in the order (01, 02, 10, 12, 20, 21).
+Eigen::Matrix<double, 3, 6> MisalignmentColumns(const Eigen::Vector3d& a) {
+  Eigen::Matrix<double, 3, 6> K = Eigen::Matrix<double, 3, 6>::Zero();
+  K(0, 0) = a(1);
+  K(0, 1) = a(2);
+  K(1, 2) = a(0);
+  K(1, 3) = a(2);
+  K(2, 4) = a(0);
+  K(2, 5) = a(1);
+  return K;
+}
 
 }  // namespace
 
@@ -228,6 +271,13 @@ void ImuPreintegration::Reset() {
   J_ba_.setZero();
   J_sg_.setZero();
   J_sa_.setZero();
+  J_mg_.setZero();
+  J_ma_.setZero();
+}
+
+void ImuPreintegration::TrackAxisMisalignment() {
+  if (num_samples_ > 0) throw std::logic_error("ImuPreintegration::TrackAxisMisalignment: after the first sample");
+  track_misalignment_ = true;
 }
 
 double ImuPreintegration::t_start_s() const {
@@ -296,6 +346,9 @@ void ImuPreintegration::Reintegrate(const ImuErrors& lin) {
 // (d/ds of x / (1 + s) is -x / (1 + s)^2), likewise for u, so
 //   J_bg <- A J_bg - B_g D_g dt,        J_ba <- A J_ba - B_a D_a dt,
 //   J_sg <- A J_sg - B_g D_g diag(a),   J_sa <- A J_sa - B_a D_a diag(u)
+// and, at zero axis misalignment, a change mg by -D_g K(a) mg with K(a) the 3x6 matrix of
+// MisalignmentColumns ((I + S + M)^-1 = D - D M D + O(M^2)), so
+//   J_mg <- A J_mg - B_g D_g K(a),      J_ma <- A J_ma - B_a D_a K(u)
 // (exact derivatives of the discrete recursion). The noise densities are taken for the
 // corrected sample (the D_g^2 on the raw noise is 1 - 2 sg, 0.4 % for 2000 ppm, left out).
 // The covariance uses B_g with
@@ -335,6 +388,10 @@ void ImuPreintegration::Propagate(const ImuSample& sample) {
   J_ba_ = A * J_ba_ - B_a * (Da * dt).asDiagonal();
   J_sg_ = A * J_sg_ - B_g * Dg.cwiseProduct(a).asDiagonal();
   J_sa_ = A * J_sa_ - B_a * Da.cwiseProduct(u).asDiagonal();
+  if (track_misalignment_) {
+    J_mg_ = A * J_mg_ - B_g * Dg.asDiagonal() * MisalignmentColumns(a);
+    J_ma_ = A * J_ma_ - B_a * Da.asDiagonal() * MisalignmentColumns(u);
+  }
 
   Matrix9d Q = gyro_arw_ * gyro_arw_ * dt * B_g * B_g.transpose();
   const double qa = accel_vrw_ * accel_vrw_;
@@ -392,6 +449,15 @@ ceres::CostFunction* CreateImuScaleFactor(std::shared_ptr<const ImuPreintegratio
       new ImuScaleFactor(MakeData(*pre, /*whiten=*/true)));
 }
 
+ceres::CostFunction* CreateImuInstrumentFactor(std::shared_ptr<const ImuPreintegration> pre) {
+  if (!pre) throw std::invalid_argument("CreateImuInstrumentFactor: null preintegration");
+  if (!pre->tracks_axis_misalignment()) {
+    throw std::invalid_argument("CreateImuInstrumentFactor: the preintegration does not track the axis misalignments");
+  }
+  return new ceres::AutoDiffCostFunction<ImuInstrumentFactor, 9, 3, 3, 4, 3, 3, 3, 3, 6, 6, 3, 3, 4>(
+      new ImuInstrumentFactor(MakeData(*pre, /*whiten=*/true)));
+}
+
 Eigen::Matrix<double, 9, 1> ImuFactorResidual(const ImuPreintegration& pre, const double* pos_i,
                                               const double* vel_i, const double* q_i,
                                               const double* bg_i, const double* ba_i,
@@ -410,7 +476,18 @@ Eigen::Matrix<double, 9, 1> ImuScaleFactorResidual(const ImuPreintegration& pre,
                                                    bool whitened) {
   const ImuFactor factor(MakeData(pre, whitened));
   Eigen::Matrix<double, 9, 1> r;
-  factor.Evaluate(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, pos_j, vel_j, q_j, r.data());
+  factor.Evaluate<double>(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, nullptr, nullptr, pos_j, vel_j, q_j, r.data());
+  return r;
+}
+
+Eigen::Matrix<double, 9, 1> ImuInstrumentFactorResidual(const ImuPreintegration& pre, const double* pos_i,
+                                                        const double* vel_i, const double* q_i, const double* bg_i,
+                                                        const double* ba_i, const double* sg_i, const double* sa_i,
+                                                        const double* mg_i, const double* ma_i, const double* pos_j,
+                                                        const double* vel_j, const double* q_j, bool whitened) {
+  const ImuFactor factor(MakeData(pre, whitened));
+  Eigen::Matrix<double, 9, 1> r;
+  factor.Evaluate(pos_i, vel_i, q_i, bg_i, ba_i, sg_i, sa_i, mg_i, ma_i, pos_j, vel_j, q_j, r.data());
   return r;
 }
 

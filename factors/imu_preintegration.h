@@ -14,6 +14,11 @@
 //   dR(bg, sg) = dR Exp(J_R_bg dbg + J_R_sg dsg),
 //   dv(bg, ba, sg, sa) = dv + J_v_bg dbg + J_v_ba dba + J_v_sg dsg + J_v_sa dsa,
 //   dp likewise (dbg = bg - bg_lin, ...).
+// Optionally (TrackAxisMisalignment) also the triads' axis misalignments, linearised at zero:
+// omega_meas = (I + S_g + M_g) omega_true + bg with M_g's six off-diagonal entries
+// mg = (M01, M02, M10, M12, M20, M21) (M_ij: axis i's sensitivity to axis j, as the
+// simulator's model, docs/imu-error-model.md), likewise M_a; they add J_R_mg mg to the
+// rotation's exponent, J_v_mg mg + J_v_ma ma to dv and the same to dp.
 // Covariance of (dphi, dv, dp), dR_meas = dR_true Exp(dphi) (dphi in body axes at j; dv,
 // dp in body axes at i), from white gyro and accelerometer noise: ARW^2 and VRW^2 per
 // second, propagated per sample (the noise inside a sample is integrated in continuous
@@ -78,6 +83,11 @@ class ImuPreintegration {
   double t_start_s() const;
   double t_end_s() const;
   std::size_t num_samples() const { return num_samples_; }
+  /// Computes the axis-misalignment Jacobians J_mg, J_ma too (header comment); before the
+  /// first sample (std::logic_error after one). Costs two 9x9 by 9x6 products per sample.
+  void TrackAxisMisalignment();
+  bool tracks_axis_misalignment() const { return track_misalignment_; }
+
   /// The samples integrated (empty after DropSamples).
   const std::vector<ImuSample>& samples() const { return samples_; }
   /// Releases the stored samples, and stores none of those integrated later, when no
@@ -113,6 +123,10 @@ class ImuPreintegration {
   Eigen::Matrix3d J_p_sg() const { return J_sg_.block<3, 3>(6, 0); }
   Eigen::Matrix3d J_v_sa() const { return J_sa_.block<3, 3>(3, 0); }
   Eigen::Matrix3d J_p_sa() const { return J_sa_.block<3, 3>(6, 0); }
+  /// Per unit axis misalignment (rad), columns mg = (M01, M02, M10, M12, M20, M21), rows
+  /// (dphi, dv, dp); zero unless TrackAxisMisalignment. d(delta_R)/d(ma) is zero.
+  const Eigen::Matrix<double, 9, 6>& J_mg() const { return J_mg_; }
+  const Eigen::Matrix<double, 9, 6>& J_ma() const { return J_ma_; }
 
   /// The linearisation point: biases and scale factors.
   const ImuErrors& lin() const { return lin_; }
@@ -148,6 +162,8 @@ class ImuPreintegration {
   Eigen::Vector3d delta_v_, delta_p_;
   Matrix9d covariance_;
   Eigen::Matrix<double, 9, 3> J_bg_, J_ba_, J_sg_, J_sa_;  // rows: dphi, dv, dp
+  bool track_misalignment_ = false;
+  Eigen::Matrix<double, 9, 6> J_mg_, J_ma_;
 };
 
 /// The IMU factor between states i and j: 9 whitened residuals (attitude, velocity,
@@ -164,6 +180,13 @@ ceres::CostFunction* CreateImuFactor(std::shared_ptr<const ImuPreintegration> pr
 /// the same 9 residuals; otherwise as CreateImuFactor.
 ceres::CostFunction* CreateImuScaleFactor(std::shared_ptr<const ImuPreintegration> pre);
 
+/// The IMU factor with scale factors and axis misalignments as unknowns (the preintegration
+/// must track them, TrackAxisMisalignment): parameter blocks
+///   (pos_i[3], vel_i[3], q_i[4], bg_i[3], ba_i[3], sg_i[3], sa_i[3], mg_i[6], ma_i[6],
+///    pos_j[3], vel_j[3], q_j[4]);
+/// the same 9 residuals. Throws std::invalid_argument otherwise.
+ceres::CostFunction* CreateImuInstrumentFactor(std::shared_ptr<const ImuPreintegration> pre);
+
 /// The same model evaluated in double: the 9 residuals, whitened or not (rad, m/s, m,
 /// NED; see the header comment). For tests, diagnostics and initial-guess checks.
 Eigen::Matrix<double, 9, 1> ImuFactorResidual(const ImuPreintegration& pre, const double* pos_i,
@@ -177,5 +200,11 @@ Eigen::Matrix<double, 9, 1> ImuScaleFactorResidual(const ImuPreintegration& pre,
                                                    const double* ba_i, const double* sg_i, const double* sa_i,
                                                    const double* pos_j, const double* vel_j, const double* q_j,
                                                    bool whitened);
+/// The same with the axis-misalignment blocks mg_i, ma_i (CreateImuInstrumentFactor's model).
+Eigen::Matrix<double, 9, 1> ImuInstrumentFactorResidual(const ImuPreintegration& pre, const double* pos_i,
+                                                        const double* vel_i, const double* q_i, const double* bg_i,
+                                                        const double* ba_i, const double* sg_i, const double* sa_i,
+                                                        const double* mg_i, const double* ma_i, const double* pos_j,
+                                                        const double* vel_j, const double* q_j, bool whitened);
 
 }  // namespace navtwin
