@@ -4,6 +4,8 @@
 //   radii at p0). Block pos {lat_rad, lon_rad, h_m} (3, PositionManifold).
 // VectorPrior3:  r = (x - x0) / sigma                          (3 residuals)
 //   Block x (3, Euclidean): velocity, a bias, scale factors.
+// IsotropicPrior<N>: r = (x - x0) / sigma, one sigma          (N residuals)
+//   Block x (N, Euclidean): e.g. the six axis misalignments of a triad.
 // ScalarPrior:   r = (x - x0) / sigma                          (1 residual)
 //   Block x (1): an installation or sensor parameter (e.g. an odometer scale factor).
 // sigma per axis (Vector3d) or one for all axes (double); each > 0 and finite.
@@ -91,6 +93,31 @@ class VectorPrior3 {
  private:
   Eigen::Vector3d x0_;
   Eigen::Vector3d inv_sigma_;
+};
+
+template <int N>
+class IsotropicPrior {
+ public:
+  using Vector = Eigen::Matrix<double, N, 1>;
+  IsotropicPrior(const Vector& x0, double std) : x0_(x0), inv_sigma_(1.0 / std) {
+    if (!(std > 0.0) || !std::isfinite(std)) throw std::invalid_argument("IsotropicPrior: std must be positive and finite");
+    if (!x0.allFinite()) throw std::invalid_argument("IsotropicPrior: x0 must be finite");
+  }
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    for (int i = 0; i < N; ++i) residual[i] = (x[i] - T(x0_[i])) * T(inv_sigma_);
+    return true;
+  }
+
+  /// N residuals; block x (N).
+  static ceres::CostFunction* Create(const Vector& x0, double std) {
+    return new ceres::AutoDiffCostFunction<IsotropicPrior, N, N>(new IsotropicPrior(x0, std));
+  }
+
+ private:
+  Vector x0_;
+  double inv_sigma_;
 };
 
 class ScalarPrior {

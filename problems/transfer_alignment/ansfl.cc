@@ -349,6 +349,12 @@ TransferConfig AnsflDotConfig() {
   c.master_velocity_mps = 0.05;
   c.settle_s = 5.0;
   c.batch_state_interval_s = 0.1;
+  // The DOTs' scale factors and axis misalignments are not estimated: no specification to
+  // take a prior from, and the paths' rotations are mostly about one axis.
+  c.gyro_scale_factor = 0.0;
+  c.accel_scale_factor = 0.0;
+  c.gyro_axis_misalignment_rad = 0.0;
+  c.accel_axis_misalignment_rad = 0.0;
   return c;
 }
 

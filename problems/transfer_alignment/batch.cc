@@ -6,14 +6,17 @@
 // config.batch_state_interval_s apart, inside the filter's span and the slave IMU record)
 //   pos_i {lat_rad, lon_rad, h_m} (PositionManifold, 3), v_n_i (3), q_n_s_i (AttitudeManifold, 3);
 // once: gyro bias bg (3, rad/s), accelerometer bias ba (3, m/s^2) (random constants), the
-// misalignment q_b_s (AttitudeManifold, 3, master body axes) and the delay tau (1, s).
+// triads' scale factors sg, sa (3 each) and axis misalignments mg, ma (6 each, the
+// off-diagonal entries of each triad's error matrix), the misalignment q_b_s
+// (AttitudeManifold, 3, master body axes) and the delay tau (1, s).
 // Residuals (whitened):
-//   IMU preintegration i -> i+1 (factors/imu_preintegration.h; slave ARW and VRW of the
-//     configuration), linearised at zero biases;
+//   IMU preintegration i -> i+1 (factors/imu_preintegration.h, CreateImuInstrumentFactor;
+//     slave ARW and VRW of the configuration), linearised at zero errors;
 //   matching (problems/transfer_alignment/transfer_match.h = problems/transfer_alignment/delay_model.h, second order, kCentral master
 //     derivatives) of state i with the record k whose data time tag_k - tau is nearest t_i:
 //     the master carried over dt = tau - (tag_k - t_i), |dt| <= half a record interval;
-//   priors: bg ~ N(0, gyro_bias), ba ~ N(0, accel_bias), q_b_s ~ the misalignment guess
+//   priors: bg ~ N(0, gyro_bias), ba ~ N(0, accel_bias), sg, sa, mg, ma ~ N(0, their
+//     configured sigma) (a zero sigma holds the block at zero), q_b_s ~ the misalignment guess
 //     with misalignment_deg, tau ~ N(delay_initial_s, delay_s) (the filter's initial
 //     uncertainty), pos_0 ~ the master's position at t_0 (plus the lever arm) with
 //     kPositionPriorSigma_m (the position gauge: nothing else fixes it).
@@ -55,6 +58,9 @@ constexpr double kTimeEps_s = 1e-6;
 /// left out; the attitude and velocity do not notice it (gravity changes by 3e-6 m/s^2
 /// per metre of height).
 constexpr double kPositionPriorSigma_m = 10.0;
+/// An instrument error whose posterior sigma is above this fraction of its prior's is named
+/// as not observable from the record (the prior, not the data, sets it).
+constexpr double kNotObservableRatio = 0.9;
 /// Rounds of re-selecting the matched master records after a solve moved the delay.
 constexpr int kMaxReselectRounds = 5;
 
@@ -79,6 +85,12 @@ void CheckBatchConfig(const TransferConfig& c) {
   positive(c.batch_state_interval_s, "batch_state_interval_s");
   if (!std::isfinite(c.delay_initial_s) || !c.lever_arm_b_m.allFinite()) {
     throw std::invalid_argument("SolveTransferBatch: config delay_initial_s and lever_arm_b_m must be finite");
+  }
+  for (const double sigma : {c.gyro_scale_factor, c.accel_scale_factor, c.gyro_axis_misalignment_rad,
+                             c.accel_axis_misalignment_rad}) {
+    if (!(sigma >= 0.0) || !std::isfinite(sigma)) {
+      throw std::invalid_argument("SolveTransferBatch: config scale-factor and axis-misalignment sigmas must be >= 0");
+    }
   }
   if (c.batch_max_iterations < 1) {
     throw std::invalid_argument("SolveTransferBatch: config batch_max_iterations must be at least 1");
@@ -120,6 +132,18 @@ class TransferBatch {
   /// delay; re-adds the changed residuals. Returns how many states changed record.
   int SelectRecords();
   void Covariance(TransferBatchSolution* out);
+  /// Priors on the scale factors and axis misalignments (zero sigma: held at zero).
+  void InstrumentPriors();
+  /// The instrument blocks with a prior (estimated), with their sigma and offset into
+  /// TransferBatchSolution::instrument_sigma.
+  struct InstrumentBlock {
+    double* x;
+    int size;
+    double sigma;
+    int offset;
+    const char* name;
+  };
+  std::vector<InstrumentBlock> InstrumentBlocks();
 
   const TransferInputs& in_;
   const TransferConfig& cfg_;
@@ -130,6 +154,8 @@ class TransferBatch {
   std::vector<State> states_;
   std::vector<std::shared_ptr<ImuPreintegration>> pre_;  ///< interval i: states i -> i + 1
   std::array<double, 3> bg_{}, ba_{};
+  std::array<double, 3> sg_{}, sa_{};  ///< scale factors
+  std::array<double, 6> mg_{}, ma_{};  ///< axis misalignments
   std::array<double, 4> q_b_s_{};
   double tau_s_ = 0.0;
 
@@ -189,6 +215,7 @@ void TransferBatch::Preintegrate() {
   for (std::size_t i = 0; i + 1 < states_.size(); ++i) {
     const double t_end = states_[i + 1].t_s;
     auto pre = std::make_shared<ImuPreintegration>(zero, zero, arw, vrw);
+    pre->TrackAxisMisalignment();
     while (true) {
       if (!have_piece) {
         if (it == imu.end()) throw std::logic_error("SolveTransferBatch: internal error, a state after the IMU record");
@@ -256,15 +283,19 @@ void TransferBatch::BuildProblem() {
   }
   problem_->AddParameterBlock(bg_.data(), 3);
   problem_->AddParameterBlock(ba_.data(), 3);
+  problem_->AddParameterBlock(sg_.data(), 3);
+  problem_->AddParameterBlock(sa_.data(), 3);
+  problem_->AddParameterBlock(mg_.data(), 6);
+  problem_->AddParameterBlock(ma_.data(), 6);
   problem_->AddParameterBlock(q_b_s_.data(), 4, &attitude_manifold_);
   problem_->AddParameterBlock(&tau_s_, 1);
 
   for (std::size_t i = 0; i + 1 < states_.size(); ++i) {
     State& a = states_[i];
     State& b = states_[i + 1];
-    problem_->AddResidualBlock(CreateImuFactor(pre_[i]), nullptr,
-                               {a.pos.data(), a.vel.data(), a.q.data(), bg_.data(), ba_.data(), b.pos.data(),
-                                b.vel.data(), b.q.data()});
+    problem_->AddResidualBlock(CreateImuInstrumentFactor(pre_[i]), nullptr,
+                               {a.pos.data(), a.vel.data(), a.q.data(), bg_.data(), ba_.data(), sg_.data(), sa_.data(),
+                                mg_.data(), ma_.data(), b.pos.data(), b.vel.data(), b.q.data()});
   }
   SelectRecords();
 
@@ -273,6 +304,7 @@ void TransferBatch::BuildProblem() {
                              nullptr, bg_.data());
   problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.accel_bias_mps2),
                              nullptr, ba_.data());
+  InstrumentPriors();
   const double mis_sigma_rad = cfg_.misalignment_rad;
   problem_->AddResidualBlock(
       AttitudePrior::Create(in_.misalignment_guess, Eigen::Matrix3d::Identity() / mis_sigma_rad), nullptr,
@@ -297,11 +329,38 @@ void TransferBatch::BuildProblem() {
                              nullptr, s0.pos.data());
 }
 
+std::vector<TransferBatch::InstrumentBlock> TransferBatch::InstrumentBlocks() {
+  return {{sg_.data(), 3, cfg_.gyro_scale_factor, 0, "gyro scale factor"},
+          {sa_.data(), 3, cfg_.accel_scale_factor, 3, "accelerometer scale factor"},
+          {mg_.data(), 6, cfg_.gyro_axis_misalignment_rad, 6, "gyro axis misalignment"},
+          {ma_.data(), 6, cfg_.accel_axis_misalignment_rad, 12, "accelerometer axis misalignment"}};
+}
+
+void TransferBatch::InstrumentPriors() {
+  for (const InstrumentBlock& b : InstrumentBlocks()) {
+    if (!(b.sigma > 0.0)) {
+      problem_->SetParameterBlockConstant(b.x);
+    } else if (b.size == 3) {
+      problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), b.sigma), nullptr, b.x);
+    } else {
+      problem_->AddResidualBlock(IsotropicPrior<6>::Create(Eigen::Matrix<double, 6, 1>::Zero(), b.sigma), nullptr, b.x);
+    }
+  }
+}
+
 void TransferBatch::Covariance(TransferBatchSolution* out) {
   // The joint covariance of the misalignment and the delay (4 tangent coordinates) by
   // ceres::Covariance (sparse QR of the whole Jacobian, then only these columns), with the
   // variance-inflation check of ComputeTangentCovariance.
-  const CovarianceResult c = ComputeTangentCovariance(*problem_, {q_b_s_.data(), &tau_s_});
+  std::vector<const double*> blocks = {q_b_s_.data(), &tau_s_};
+  std::vector<InstrumentBlock> estimated;
+  for (const InstrumentBlock& b : InstrumentBlocks()) {
+    if (b.sigma > 0.0) {
+      blocks.push_back(b.x);
+      estimated.push_back(b);
+    }
+  }
+  const CovarianceResult c = ComputeTangentCovariance(*problem_, blocks);
   if (!c.covariance) {
     throw std::runtime_error("SolveTransferBatch: the misalignment and delay covariance is not computable: " +
                              c.message);
@@ -310,6 +369,19 @@ void TransferBatch::Covariance(TransferBatchSolution* out) {
   out->misalignment_sigma_rad = P.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt();
   out->delay_sigma_s = std::sqrt(std::max(0.0, P(3, 3)));
   out->misalignment_delay_covariance = P.topLeftCorner<4, 4>();
+  // The instrument errors: sigma, and those the record leaves at their prior.
+  static const char* kAxes[6] = {"xy", "xz", "yx", "yz", "zx", "zy"};
+  int row = 4;
+  for (const InstrumentBlock& b : estimated) {
+    for (int k = 0; k < b.size; ++k, ++row) {
+      const double sigma = std::sqrt(std::max(0.0, P(row, row)));
+      out->instrument_sigma[b.offset + k] = sigma;
+      if (sigma > kNotObservableRatio * b.sigma) {
+        out->instrument_not_observable.push_back(std::string(b.name) + " " +
+                                                 (b.size == 3 ? std::string(1, "xyz"[k]) : std::string(kAxes[k])));
+      }
+    }
+  }
 }
 
 TransferBatchSolution TransferBatch::Run() {
@@ -356,6 +428,10 @@ TransferBatchSolution TransferBatch::Run() {
   out.delay_s = tau_s_;
   out.gyro_bias_radps = Eigen::Map<const Eigen::Vector3d>(bg_.data());
   out.accel_bias_mps2 = Eigen::Map<const Eigen::Vector3d>(ba_.data());
+  out.gyro_scale_factor = Eigen::Map<const Eigen::Vector3d>(sg_.data());
+  out.accel_scale_factor = Eigen::Map<const Eigen::Vector3d>(sa_.data());
+  out.gyro_axis_misalignment_rad = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(mg_.data());
+  out.accel_axis_misalignment_rad = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(ma_.data());
   const int week = start_.epochs.front().slave.gps_week;
   for (const State& s : states_) {
     NavState n;

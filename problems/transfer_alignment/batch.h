@@ -14,6 +14,7 @@
 // differences).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -34,6 +35,16 @@ struct TransferBatchSolution {
   Eigen::Matrix4d misalignment_delay_covariance = Eigen::Matrix4d::Zero();
   Eigen::Vector3d gyro_bias_radps = Eigen::Vector3d::Zero();
   Eigen::Vector3d accel_bias_mps2 = Eigen::Vector3d::Zero();
+  /// The slave triads' scale factors (dimensionless) and axis misalignments (rad, entries
+  /// 01, 02, 10, 12, 20, 21 of the error matrix), with their sigma (0 when not estimated).
+  Eigen::Vector3d gyro_scale_factor = Eigen::Vector3d::Zero(), accel_scale_factor = Eigen::Vector3d::Zero();
+  Eigen::Matrix<double, 6, 1> gyro_axis_misalignment_rad = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> accel_axis_misalignment_rad = Eigen::Matrix<double, 6, 1>::Zero();
+  /// sigma of [gyro scale factors (3), accel scale factors (3), gyro misalignments (6), accel (6)].
+  Eigen::Matrix<double, 18, 1> instrument_sigma = Eigen::Matrix<double, 18, 1>::Zero();
+  /// The instrument errors the record does not determine: named ("gyro scale factor x", ...)
+  /// when their posterior sigma is above 0.9 of the prior's.
+  std::vector<std::string> instrument_not_observable;
   std::vector<NavState> states;  ///< the smoothed slave states (attitude R_n_s)
   int iterations = 0;
   double final_cost = 0.0;

@@ -17,6 +17,8 @@ namespace {
 
 TransferConfig ParseRoot(const ConfigNode& n) {
   n.RequireKeys({"gyro_bias_deg_h", "gyro_arw_deg_sqrt_h", "accel_bias_ug", "accel_vrw_m_s_sqrt_h",
+                 "gyro_scale_factor_ppm", "accel_scale_factor_ppm", "gyro_axis_misalignment_arcsec",
+                 "accel_axis_misalignment_arcsec",
                  "initial_velocity_mps", "initial_attitude_deg", "misalignment_deg", "delay_s", "delay_initial_s",
                  "master_attitude_mrad", "master_velocity_mps", "master_fit_window_s", "lever_arm_b_m", "settle_s",
                  "batch_state_interval_s", "batch_max_iterations", "history_window_s"});
@@ -28,6 +30,12 @@ TransferConfig ParseRoot(const ConfigNode& n) {
   c.accel_bias_mps2 = n.NonNegativeSi("accel_bias_ug", kMicroG_mps2, c.accel_bias_mps2);
   c.accel_vrw_mps_per_sqrt_s =
       n.NonNegativeSi("accel_vrw_m_s_sqrt_h", kMpsPerSqrtHour_mpspsqrts, c.accel_vrw_mps_per_sqrt_s);
+  c.gyro_scale_factor = n.NonNegativeSi("gyro_scale_factor_ppm", kPpm, c.gyro_scale_factor);
+  c.accel_scale_factor = n.NonNegativeSi("accel_scale_factor_ppm", kPpm, c.accel_scale_factor);
+  c.gyro_axis_misalignment_rad =
+      n.NonNegativeSi("gyro_axis_misalignment_arcsec", kArcsec_rad, c.gyro_axis_misalignment_rad);
+  c.accel_axis_misalignment_rad =
+      n.NonNegativeSi("accel_axis_misalignment_arcsec", kArcsec_rad, c.accel_axis_misalignment_rad);
   // Initial standard deviations: diagonal entries of P0, so > 0.
   c.initial_velocity_mps = n.Positive("initial_velocity_mps", c.initial_velocity_mps);
   c.initial_attitude_rad = n.PositiveSi("initial_attitude_deg", kDegToRad, c.initial_attitude_rad);

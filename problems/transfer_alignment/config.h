@@ -18,6 +18,13 @@ struct TransferConfig {
   double gyro_arw_rad_per_sqrt_s = 0.05 * kDegPerSqrtHour_radpsqrts;     ///< key gyro_arw_deg_sqrt_h
   double accel_bias_mps2 = 200.0 * kMicroG_mps2;                         ///< key accel_bias_ug
   double accel_vrw_mps_per_sqrt_s = 0.05 * kMpsPerSqrtHour_mpspsqrts;    ///< key accel_vrw_m_s_sqrt_h
+  /// The slave triads' scale factors and axis misalignments (the six off-diagonal entries of
+  /// each triad's error matrix, factors/imu_preintegration.h): 1-sigma priors of the batch,
+  /// which estimates them; 0 = not estimated (held at zero). The filters do not model them.
+  double gyro_scale_factor = 100.0 * kPpm;                   ///< key gyro_scale_factor_ppm
+  double accel_scale_factor = 100.0 * kPpm;                  ///< key accel_scale_factor_ppm
+  double gyro_axis_misalignment_rad = 20.0 * kArcsec_rad;    ///< key gyro_axis_misalignment_arcsec
+  double accel_axis_misalignment_rad = 20.0 * kArcsec_rad;   ///< key accel_axis_misalignment_arcsec
   // Initial uncertainty (1 sigma).
   double initial_velocity_mps = 1.0;
   double initial_attitude_rad = 2.0 * kDegToRad;  ///< key initial_attitude_deg

@@ -112,6 +112,12 @@ TransferResult RunBatchMethod(const TransferInputs& inputs, const TransferConfig
   std::ostringstream note;
   note << (r.note.empty() ? "" : "; ") << "batch: " << sol.states.size() << " states, " << sol.iterations
        << " iterations, final cost " << sol.final_cost;
+  if (!sol.instrument_not_observable.empty()) {
+    note << "; not observable (posterior sigma above 0.9 of the prior's):";
+    for (std::size_t i = 0; i < sol.instrument_not_observable.size(); ++i) {
+      note << (i == 0 ? " " : ", ") << sol.instrument_not_observable[i];
+    }
+  }
   r.note += note.str();
   return r;
 }

@@ -177,6 +177,23 @@ TEST(VectorPrior3, ResidualAndTangentJacobian) {
   }
 }
 
+// (x - x0) / sigma on six entries; its Jacobian is I / sigma (Linearize against the value).
+TEST(IsotropicPrior, ResidualAndJacobian) {
+  Eigen::Matrix<double, 6, 1> x0, x;
+  x0 << 1, -2, 3, 0, 0.5, -1;
+  x << 2, -2, 2, 1, 0.5, -3;
+  const std::unique_ptr<ceres::CostFunction> f(IsotropicPrior<6>::Create(x0, 0.5));
+  const std::vector<Block> blocks = {{std::vector<double>(x.data(), x.data() + 6), nullptr, kVecStep}};
+  Eigen::Matrix<double, 6, 1> expected;
+  expected << 2, 0, -2, 2, 0, -4;
+  EXPECT_EQ(Residual(*f, blocks), Eigen::VectorXd(expected));
+  ExpectTangentJacobiansMatch(*f, blocks, kJacobianTol);
+  EXPECT_LT((LinearizeAt(*f, blocks).jacobians[0] - 2.0 * Eigen::MatrixXd::Identity(6, 6)).norm(), 1e-12);
+  for (const double bad : {0.0, -1.0, kNaN, kInf}) EXPECT_THROW(IsotropicPrior<6>(x0, bad), std::invalid_argument);
+  x0(2) = kNaN;
+  EXPECT_THROW(IsotropicPrior<6>(x0, 1.0), std::invalid_argument);
+}
+
 TEST(StatePrior, RejectsBadSigma) {
   const Eigen::Vector3d p0(0.5, 0.5, 0.0);
   for (const double bad : {0.0, -1.0, kNaN, kInf}) {

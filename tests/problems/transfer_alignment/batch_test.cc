@@ -101,18 +101,19 @@ void CheckBatch(const TransferInputs& in, const char* label) {
   // The goal: within 1 ms of the truth; and consistent with its own sigma.
   EXPECT_LT(std::abs(sol.delay_s - true_delay), 1e-3);
   EXPECT_LT(std::abs(sol.delay_s - true_delay), 3.0 * sol.delay_sigma_s);
-  // The sigma of ceres::Covariance covers the white noise of the model only. The simulated
-  // slave IMU also has 20 arcsec (0.097 mrad) axis misalignments and 100 ppm scale factors
-  // per gyro and accelerometer that neither the batch nor the filter models; they tilt the
-  // slave's sensed specific force and rate and so shift the misalignment by up to about
-  // that angle (the preset with them set to zero, seed 1: |mu| <= 0.029 mrad = 1.1 sigma;
-  // with them: 0.070 mrad on pitch = 3.7 sigma; docs/transfer-alignment-batch.md). So the
-  // bound is 3 sigma and that angle added in quadrature.
-  constexpr double kUnmodelledAxisMisalignment_rad = 20.0 * kArcsec_rad;
+  // The batch estimates the slave triads' scale factors and axis misalignments (100 ppm,
+  // 20 arcsec in the simulation and the default priors), so its misalignment sigma covers
+  // them: measured |error| 0.46-1.33 sigma on the short flight and the preset (without them
+  // in the model it was 3.7 sigma on the preset's pitch). Bound: 3 sigma per axis.
   for (int i = 0; i < 3; ++i) {
     const double sigma = sol.misalignment_sigma_rad[i];
     std::printf("misalignment axis %d: |error| = %.2f sigma\n", i, std::abs(mu_rad[i]) / sigma);
-    EXPECT_LT(std::abs(mu_rad[i]), std::hypot(3.0 * sigma, kUnmodelledAxisMisalignment_rad)) << "axis " << i;
+    EXPECT_LT(std::abs(mu_rad[i]), 3.0 * sigma) << "axis " << i;
+  }
+  if (!sol.instrument_not_observable.empty()) {
+    std::printf("not observable:");
+    for (const std::string& name : sol.instrument_not_observable) std::printf(" [%s]", name.c_str());
+    std::printf("\n");
   }
   for (int i = 0; i < 3; ++i) EXPECT_LT(b.rms_mrad[i], f.rms_mrad[i]) << "axis " << i;
 }

@@ -18,6 +18,10 @@ constexpr const char* kEveryKey = R"(gyro_bias_deg_h: 2.5
 gyro_arw_deg_sqrt_h: 0.07
 accel_bias_ug: 150
 accel_vrw_m_s_sqrt_h: 0.03
+gyro_scale_factor_ppm: 50
+accel_scale_factor_ppm: 0
+gyro_axis_misalignment_arcsec: 10
+accel_axis_misalignment_arcsec: 30
 initial_velocity_mps: 0.8
 initial_attitude_deg: 1.5
 misalignment_deg: 3
@@ -38,6 +42,10 @@ TEST(TransferConfigTest, EveryKeyIsRead) {
   EXPECT_EQ(c.gyro_arw_rad_per_sqrt_s, 0.07 * kDegPerSqrtHour_radpsqrts);
   EXPECT_EQ(c.accel_bias_mps2, 150.0 * kMicroG_mps2);
   EXPECT_EQ(c.accel_vrw_mps_per_sqrt_s, 0.03 * kMpsPerSqrtHour_mpspsqrts);
+  EXPECT_EQ(c.gyro_scale_factor, 50 * kPpm);
+  EXPECT_EQ(c.accel_scale_factor, 0.0);
+  EXPECT_EQ(c.gyro_axis_misalignment_rad, 10 * kArcsec_rad);
+  EXPECT_EQ(c.accel_axis_misalignment_rad, 30 * kArcsec_rad);
   EXPECT_EQ(c.initial_velocity_mps, 0.8);
   EXPECT_EQ(c.initial_attitude_rad, 1.5 * kDegToRad);
   EXPECT_EQ(c.misalignment_rad, 3.0 * kDegToRad);
@@ -71,6 +79,10 @@ TEST(TransferConfigTest, ShippedPresetFileListsEveryKeyWithTheDefaults) {
   EXPECT_EQ(c.gyro_arw_rad_per_sqrt_s, d.gyro_arw_rad_per_sqrt_s);
   EXPECT_EQ(c.accel_bias_mps2, d.accel_bias_mps2);
   EXPECT_EQ(c.accel_vrw_mps_per_sqrt_s, d.accel_vrw_mps_per_sqrt_s);
+  EXPECT_EQ(c.gyro_scale_factor, d.gyro_scale_factor);
+  EXPECT_EQ(c.accel_scale_factor, d.accel_scale_factor);
+  EXPECT_EQ(c.gyro_axis_misalignment_rad, d.gyro_axis_misalignment_rad);
+  EXPECT_EQ(c.accel_axis_misalignment_rad, d.accel_axis_misalignment_rad);
   EXPECT_EQ(c.initial_velocity_mps, d.initial_velocity_mps);
   EXPECT_EQ(c.initial_attitude_rad, d.initial_attitude_rad);
   EXPECT_EQ(c.misalignment_rad, d.misalignment_rad);
@@ -117,7 +129,7 @@ TEST(TransferConfigTest, ValuesOutOfRangeNameTheKeyAndLine) {
       {"settle_s", "-1"},             {"batch_state_interval_s", "0"}, {"batch_max_iterations", "0"},
       {"gyro_bias_deg_h", "-1"},      {"gyro_arw_deg_sqrt_h", "-0.1"}, {"accel_bias_ug", "-5"},
       {"accel_vrw_m_s_sqrt_h", "-1"}, {"delay_s", "abc"},              {"lever_arm_b_m", "[1, 2]"},
-      {"batch_max_iterations", "2.5"}, {"history_window_s", "0"}};
+      {"batch_max_iterations", "2.5"}, {"history_window_s", "0"}, {"gyro_axis_misalignment_arcsec", "-1"}};
   for (const Case& c : cases) {
     const std::string text = std::string("delay_initial_s: 0.1\n") + c.key + ": " + c.value + "\n";
     const InputError e = ErrorOf(text);
