@@ -204,18 +204,6 @@ class ImuInstrumentFactor {
   ImuFactor factor_;
 };
 
-/// d a / d mg at zero misalignment for a corrected increment a (header comment): column
-/// (i, j) is a_j e_i, in the order (01, 02, 10, 12, 20, 21).
-Eigen::Matrix<double, 3, 6> MisalignmentColumns(const Eigen::Vector3d& a) {
-  Eigen::Matrix<double, 3, 6> K = Eigen::Matrix<double, 3, 6>::Zero();
-  K(0, 0) = a(1);
-  K(0, 1) = a(2);
-  K(1, 2) = a(0);
-  K(1, 3) = a(2);
-  K(2, 4) = a(0);
-  K(2, 5) = a(1);
-  return K;
-}
 
 }  // namespace
 
@@ -347,7 +335,7 @@ void ImuPreintegration::Reintegrate(const ImuErrors& lin) {
 //   J_bg <- A J_bg - B_g D_g dt,        J_ba <- A J_ba - B_a D_a dt,
 //   J_sg <- A J_sg - B_g D_g diag(a),   J_sa <- A J_sa - B_a D_a diag(u)
 // and, at zero axis misalignment, a change mg by -D_g K(a) mg with K(a) the 3x6 matrix of
-// MisalignmentColumns ((I + S + M)^-1 = D - D M D + O(M^2)), so
+// AxisMisalignmentColumns (core/imu_errors.h) ((I + S + M)^-1 = D - D M D + O(M^2)), so
 //   J_mg <- A J_mg - B_g D_g K(a),      J_ma <- A J_ma - B_a D_a K(u)
 // (exact derivatives of the discrete recursion). The noise densities are taken for the
 // corrected sample (the D_g^2 on the raw noise is 1 - 2 sg, 0.4 % for 2000 ppm, left out).
@@ -389,8 +377,8 @@ void ImuPreintegration::Propagate(const ImuSample& sample) {
   J_sg_ = A * J_sg_ - B_g * Dg.cwiseProduct(a).asDiagonal();
   J_sa_ = A * J_sa_ - B_a * Da.cwiseProduct(u).asDiagonal();
   if (track_misalignment_) {
-    J_mg_ = A * J_mg_ - B_g * Dg.asDiagonal() * MisalignmentColumns(a);
-    J_ma_ = A * J_ma_ - B_a * Da.asDiagonal() * MisalignmentColumns(u);
+    J_mg_ = A * J_mg_ - B_g * Dg.asDiagonal() * AxisMisalignmentColumns(a);
+    J_ma_ = A * J_ma_ - B_a * Da.asDiagonal() * AxisMisalignmentColumns(u);
   }
 
   Matrix9d Q = gyro_arw_ * gyro_arw_ * dt * B_g * B_g.transpose();

@@ -19,8 +19,9 @@ struct TransferConfig {
   double accel_bias_mps2 = 200.0 * kMicroG_mps2;                         ///< key accel_bias_ug
   double accel_vrw_mps_per_sqrt_s = 0.05 * kMpsPerSqrtHour_mpspsqrts;    ///< key accel_vrw_m_s_sqrt_h
   /// The slave triads' scale factors and axis misalignments (the six off-diagonal entries of
-  /// each triad's error matrix, factors/imu_preintegration.h): 1-sigma priors of the batch,
-  /// which estimates them; 0 = not estimated (held at zero). The filters do not model them.
+  /// each triad's error matrix, core/imu_errors.h): 1-sigma priors of the batch and of the
+  /// history filter, which estimate them; 0 = not estimated (held at zero). The order-1
+  /// and order-2 filters do not model them.
   double gyro_scale_factor = 100.0 * kPpm;                   ///< key gyro_scale_factor_ppm
   double accel_scale_factor = 100.0 * kPpm;                  ///< key accel_scale_factor_ppm
   double gyro_axis_misalignment_rad = 20.0 * kArcsec_rad;    ///< key gyro_axis_misalignment_arcsec

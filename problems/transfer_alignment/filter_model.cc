@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/earth.h"
+#include "core/imu_errors.h"
 #include "core/imu_split.h"
 #include "problems/ins/ins_state.h"
 
@@ -76,7 +77,8 @@ TransferVector TransferProcessNoise(const TransferConfig& c) {
   return q;
 }
 
-TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s) {
+void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatrix* F,
+                           InstrumentColumns* F_instrument) {
   using tstate::kAtt;
   using tstate::kVel;
   const double dt = s.dt_s;
@@ -85,12 +87,29 @@ TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s) {
   const Eigen::Vector3d f_s = s.dv_b_mps / dt, w_s = s.dtheta_b_rad / dt;
   // The noise does not enter F.
   const Eigen::MatrixXd F15 = ins::ErrorDynamicsF(x, f_s, w_s, ins::ImuNoise{}, ins::err::kSize15);
-  TransferMatrix F = TransferMatrix::Zero();
-  F.block<3, 3>(kVel, kVel) = F15.block<3, 3>(ins::err::kVel, ins::err::kVel);
-  F.block<3, 3>(kVel, kAtt) = F15.block<3, 3>(ins::err::kVel, ins::err::kAtt);
-  F.block<3, 3>(kAtt, kVel) = F15.block<3, 3>(ins::err::kAtt, ins::err::kVel);
-  F.block<3, 3>(kAtt, kAtt) = F15.block<3, 3>(ins::err::kAtt, ins::err::kAtt);
-  const TransferMatrix Fdt = F * dt;
+  F->setZero();
+  F->block<3, 3>(kVel, kVel) = F15.block<3, 3>(ins::err::kVel, ins::err::kVel);
+  F->block<3, 3>(kVel, kAtt) = F15.block<3, 3>(ins::err::kVel, ins::err::kAtt);
+  F->block<3, 3>(kAtt, kVel) = F15.block<3, 3>(ins::err::kAtt, ins::err::kVel);
+  F->block<3, 3>(kAtt, kAtt) = F15.block<3, 3>(ins::err::kAtt, ins::err::kAtt);
+  if (F_instrument == nullptr) return;
+  const Eigen::Matrix3d F_att_bg = F15.block<3, 3>(ins::err::kAtt, ins::err::kBg);
+  const Eigen::Matrix3d F_vel_ba = F15.block<3, 3>(ins::err::kVel, ins::err::kBa);
+  F_instrument->setZero();
+  F_instrument->block<3, 3>(kAtt, istate::kSg) = F_att_bg * w_s.asDiagonal();
+  F_instrument->block<3, 6>(kAtt, istate::kMg) = F_att_bg * AxisMisalignmentColumns(w_s);
+  F_instrument->block<3, 3>(kVel, istate::kSa) = F_vel_ba * f_s.asDiagonal();
+  F_instrument->block<3, 6>(kVel, istate::kMa) = F_vel_ba * AxisMisalignmentColumns(f_s);
+}
+
+TransferMatrix TransferErrorDynamics(const NavState& nav, const ImuSample& s) {
+  TransferMatrix F;
+  TransferErrorDynamics(nav, s, &F, nullptr);
+  return F;
+}
+
+TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s) {
+  const TransferMatrix Fdt = TransferErrorDynamics(nav, s) * s.dt_s;
   return TransferMatrix::Identity() + Fdt + 0.5 * Fdt * Fdt;
 }
 

@@ -58,8 +58,30 @@ TransferVector TransferInitialSigma(const TransferConfig& config);
 /// Continuous process-noise PSD per state (header comment).
 TransferVector TransferProcessNoise(const TransferConfig& config);
 
-/// Transition over one IMU sample s from the nominal slave state nav (at the sample's
-/// start): Phi = I + F dt + (F dt)^2 / 2 with F the dv/phi block of ins::ErrorDynamicsF.
+/// The slave triads' instrument errors as filter states (history_filter.h):
+/// [sg (3), sa (3), mg (6), ma (6)], scale factors and axis misalignments
+/// (core/imu_errors.h), random constants.
+constexpr int kInstrumentStates = 18;
+using InstrumentColumns = Eigen::Matrix<double, kTransferStates, kInstrumentStates>;
+namespace istate {
+constexpr int kSg = 0;
+constexpr int kSa = 3;
+constexpr int kMg = 6;
+constexpr int kMa = 12;
+}  // namespace istate
+
+/// F as below and d(dx_dot)/d(instrument errors) (10 x 18): a gyro error matrix E_g acts as
+/// a bias E_g omega, so its columns are F's gyro-bias columns (ins::ErrorDynamicsF) times
+/// diag(omega) (sg) and AxisMisalignmentColumns(omega) (mg); the accelerometer's likewise
+/// with f. omega and f from the sample (already corrected for the current estimates).
+void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatrix* F,
+                           InstrumentColumns* F_instrument);
+
+/// F of the error state over one IMU sample s from the nominal slave state nav (at the
+/// sample's start): the dv/phi block of ins::ErrorDynamicsF, zero elsewhere.
+TransferMatrix TransferErrorDynamics(const NavState& nav, const ImuSample& s);
+
+/// Transition over the sample: Phi = I + F dt + (F dt)^2 / 2 with F above.
 TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s);
 
 /// The slave position set from the master record carried forward over tau with its

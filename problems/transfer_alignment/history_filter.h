@@ -7,14 +7,16 @@
 // framework for processing relative state measurements", ICRA 2002).
 // docs/transfer-alignment.md, "Delayed-state fusion", has the derivation.
 //
-// State: the 10 error states of filter_model.h (dv, phi of the slave now, mu, dtau) and,
-// per clone j, the slave's [dv, phi] at the clone's time c_j (6 each). A clone is taken
-// at the start and after every update (at each record's tag); clones older than the
+// State: the 10 error states of filter_model.h (dv, phi of the slave now, mu, dtau), the
+// slave triads' scale factors and axis misalignments (18, filter_model.h's instrument
+// states; priors from the configuration, as the batch's; their estimates correct every
+// sample before the strapdown) and, per clone j, the slave's [dv, phi] at the clone's time
+// c_j (6 each). A clone is taken at the start and after an update when the newest is
+// kCloneSpacing_s old (at a record's tag); clones older than the
 // history the delay needs (|tau| + 4 sigma_tau + a margin, at most
-// config.history_window_s) are dropped. Clones are constants; the present's errors
-// propagate with filter_model.h's transition and process noise, and the cross-covariance
-// of the present with the clones follows with the accumulated transition (applied at the
-// next update: the clones' blocks do not change in between).
+// config.history_window_s) are dropped. Clones and instrument errors are constants; the
+// present's errors propagate with filter_model.h's transition and process noise, applied
+// to P once per update as the product of the transitions since the last one.
 //
 // Measurement at record k (tag t, data time s = t - tau): the residuals of delay_model.h
 // with no carry (delay 0), the master's attitude and velocity at its data time against the

@@ -437,12 +437,7 @@ TEST(ImuPreintegration, FactorCorrectsScaleFactorsToFirstOrder) {
 std::vector<ImuSample> WithInstrumentErrors(const std::vector<ImuSample>& truth_samples, const ImuErrors& lin,
                                             const Eigen::Matrix<double, 6, 1>& mg,
                                             const Eigen::Matrix<double, 6, 1>& ma) {
-  const auto full = [](const Eigen::Vector3d& s, const Eigen::Matrix<double, 6, 1>& m) {
-    Eigen::Matrix3d E = Eigen::Matrix3d(s.asDiagonal());
-    E(0, 1) = m(0), E(0, 2) = m(1), E(1, 0) = m(2), E(1, 2) = m(3), E(2, 0) = m(4), E(2, 1) = m(5);
-    return Eigen::Matrix3d(Eigen::Matrix3d::Identity() + E);
-  };
-  const Eigen::Matrix3d Eg = full(lin.sg, mg), Ea = full(lin.sa, ma);
+  const Eigen::Matrix3d Eg = TriadErrorMatrix(lin.sg, mg), Ea = TriadErrorMatrix(lin.sa, ma);
   std::vector<ImuSample> out = truth_samples;
   for (ImuSample& x : out) {
     x.dtheta_b_rad = Eg * x.dtheta_b_rad + lin.bg_radps * x.dt_s;
