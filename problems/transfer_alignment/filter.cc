@@ -174,11 +174,7 @@ class TransferFilter {
     return sigma;
   }
 
-  [[noreturn]] static void Fail(double t_s, const char* what) {
-    std::ostringstream m;
-    m << "RunTransferFilter: " << what << " became non-finite at t = " << t_s << " s";
-    throw std::runtime_error(m.str());
-  }
+  [[noreturn]] static void Fail(double t_s, const char* what) { ThrowNonFinite("RunTransferFilter", t_s, what); }
 
   const TransferConfig& cfg_;
   DelayOrder order_;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -119,6 +120,12 @@ void ResetSlavePosition(const NavState& record, double tau_s, NavState* slave) {
   slave->lat_rad = lat + d_n_m.x() / (wgs84::MeridianRadius(lat) + h);
   slave->lon_rad = record.lon_rad + d_n_m.y() / ((wgs84::PrimeVerticalRadius(lat) + h) * std::cos(lat));
   slave->h_m = h - d_n_m.z();
+}
+
+void ThrowNonFinite(const char* who, double t_s, const char* what) {
+  std::ostringstream m;
+  m << who << ": " << what << " became non-finite at t = " << t_s << " s";
+  throw std::runtime_error(m.str());
 }
 
 void WalkSlaveImu(const std::vector<ImuSample>& slave_imu, const MasterStream& master, double t0_s,

@@ -89,6 +89,9 @@ TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s);
 /// which the velocity dynamics barely feel).
 void ResetSlavePosition(const NavState& record, double tau_s, NavState* slave);
 
+/// Throws std::runtime_error "<who>: <what> became non-finite at t = <t_s> s".
+[[noreturn]] void ThrowNonFinite(const char* who, double t_s, const char* what);
+
 /// Walks the slave IMU from t0_s: calls propagate(sample) for each sample (or the part of
 /// one up to a master tag inside it) and update(k) for each master record k whose tag lies
 /// in [t0_s, last slave sample], after the slave has been stepped to the tag.

@@ -348,11 +348,7 @@ class HistoryFilter {
     nodes_.back() = {s.t_s, s.q_n_b, s.v_n_mps};
   }
 
-  [[noreturn]] static void Fail(double t_s, const char* what) {
-    std::ostringstream m;
-    m << "RunHistoryFilter: " << what << " became non-finite at t = " << t_s << " s";
-    throw std::runtime_error(m.str());
-  }
+  [[noreturn]] static void Fail(double t_s, const char* what) { ThrowNonFinite("RunHistoryFilter", t_s, what); }
 
   const TransferConfig& cfg_;
   MasterStream master_;
@@ -361,7 +357,7 @@ class HistoryFilter {
   double tau_s_ = 0.0;
   TransferVector q_;  // continuous process-noise PSD per state
   const std::vector<ImuSample>& slave_imu_;
-  MatrixXd P_;                 // [present (10), clone 0 (6), clone 1 (6), ...]
+  MatrixXd P_;  // [present: x (10), instrument errors (18); clone 0 (6), clone 1 (6), ...]
   // Transition since the last update, not yet in the present-clone cross blocks:
   // [[acc_xx_, acc_xi_], [0, I]].
   TransferMatrix acc_xx_;
