@@ -104,6 +104,7 @@ class TransferFilter {
     Vector10 dx_i = Vector10::Zero();
     Eigen::MatrixXd Hw;
     Eigen::VectorXd y;
+    double nis0 = std::nan("");
     for (int it = 0; it < kUpdateIterations; ++it) {
       const Eigen::Quaterniond q_i = ApplyAttitudeError<double>(Vector3d(dx_i.segment<3>(kAtt)), s.q_n_b);
       const Eigen::Quaterniond m_i = ApplyAttitudeError<double>(Vector3d(dx_i.segment<3>(kMis)), misalignment_);
@@ -115,7 +116,9 @@ class TransferFilter {
       if (it + 1 == kUpdateIterations) break;
       const Eigen::MatrixXd& P = kf_.P();
       const Eigen::MatrixXd S = Hw * P * Hw.transpose() + Eigen::MatrixXd::Identity(6, 6);
-      dx_i = P * Hw.transpose() * S.ldlt().solve(y);
+      const Eigen::LDLT<Eigen::MatrixXd> S_ldlt(S);
+      if (it == 0) nis0 = y.dot(S_ldlt.solve(y));
+      dx_i = P * Hw.transpose() * S_ldlt.solve(y);
       if (!dx_i.allFinite()) Fail(kin.tag_s, "the iterated correction");
     }
     r = r0;
@@ -139,6 +142,7 @@ class TransferFilter {
     e.delay_s = tau_s_;
     e.sigma = kf_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
     e.innovation = -r;
+    e.nis = nis0;
     out->epochs.push_back(e);
   }
 

@@ -16,6 +16,7 @@
 // on misalignment and delay (flexure, clock wander; configurable).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct TransferEpoch {
   double delay_s = 0.0;
   Eigen::Matrix<double, kTransferStates, 1> sigma;  ///< sqrt diag P after the update
   Eigen::Matrix<double, 6, 1> innovation;           ///< [velocity m/s, attitude rad]
+  /// Normalised innovation squared of the record at the prior estimate, y^T S^-1 y with
+  /// S = H P H^T + R (chi-square with 6 degrees of freedom when the filter is consistent);
+  /// NaN when the record was not used.
+  double nis = std::nan("");
 };
 
 struct TransferFilterRun {

@@ -246,7 +246,8 @@ class HistoryFilter {
     ResetSlavePosition(master_.record(k), tau_s_, &s);
     ins_.SetState(s);
     Eigen::Matrix<double, 6, 1> r0;
-    const bool used = Correct(kin, &r0);
+    double nis0 = std::nan("");
+    const bool used = Correct(kin, &r0, &nis0);
     if (!used) ++out->records_outside_history;
     AddClone();
     TransferEpoch e;
@@ -257,12 +258,13 @@ class HistoryFilter {
     e.delay_s = tau_s_;
     e.sigma = P_.diagonal().head<kTransferStates>().cwiseMax(0.0).cwiseSqrt();
     e.innovation = used ? Eigen::Matrix<double, 6, 1>(-r0) : Eigen::Matrix<double, 6, 1>::Constant(std::nan(""));
+    e.nis = nis0;
     out->epochs.push_back(e);
   }
 
-  /// The iterated update with record kin (history_filter.h); r0: the residual at the prior
-  /// estimate. False (nothing changed) when the data time lies outside the history.
-  bool Correct(const MasterKinematics& kin, Eigen::Matrix<double, 6, 1>* r0) {
+  /// The iterated update with record kin (history_filter.h); r0, nis0: the residual and the
+  /// normalised innovation squared at the prior estimate. False (nothing changed) when the data time lies outside the history.
+  bool Correct(const MasterKinematics& kin, Eigen::Matrix<double, 6, 1>* r0, double* nis0) {
     const int N = static_cast<int>(P_.rows());
     const Vector6 inv_sigma = (Vector6() << Vector3d::Constant(cfg_.master_velocity_mps),
                                Vector3d::Constant(cfg_.master_attitude_rad))
@@ -299,6 +301,7 @@ class HistoryFilter {
         HPHt.noalias() += H.middleCols(col, len[g]).lazyProduct(PHt.middleRows(idx[g], len[g]));
       }
       S.compute(HPHt);
+      if (it == 0) *nis0 = y.dot(S.solve(y));
       const VectorXd dx_next = PHt * S.solve(y);
       if (!dx_next.allFinite()) Fail(kin.tag_s, "the iterated correction");
       // The linearisation point moved by less than the model's nonlinearity can feel (the

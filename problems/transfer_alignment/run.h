@@ -38,6 +38,10 @@ struct TransferResult {
   /// e^T P^-1 e of e = [Log(M_true M_est^T), tau_true - tau_est] with the covariance above
   /// (chi-square with 4 degrees of freedom when the estimate is consistent); NaN without truth.
   double nees_misalignment_delay = std::nan("");
+  /// Filters: the mean normalised innovation squared of the records after settle_s (6 when
+  /// the filter's sigma are right; much larger: they understate its errors; needs no
+  /// truth). NaN for the batch.
+  double nis_mean = std::nan("");
   Eigen::Vector3d misalignment_true_deg = Eigen::Vector3d::Constant(std::nan(""));  ///< when known
   double delay_true_s = std::nan("");  ///< when known
   /// What the errors were scored against ("slave truth", "body truth: ..."), or why not.

@@ -142,6 +142,8 @@ TEST(TransferRunTest, JsonHasTheIssuesKeysInOrderAndNullForNaN) {
   // Unknown truth: null, never NaN (invalid JSON).
   EXPECT_NE(json.find("\"delay_true_s\":null"), std::string::npos) << json;
   EXPECT_NE(json.find("\"misalignment_error_mrad\":null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"nees_misalignment_delay\":null"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"nis_mean\":null"), std::string::npos) << json;
   EXPECT_EQ(json.find("nan"), std::string::npos) << json;
   TransferResult none;
   const std::string j2 = TransferResultJson(none);
@@ -150,7 +152,9 @@ TEST(TransferRunTest, JsonHasTheIssuesKeysInOrderAndNullForNaN) {
 }
 
 TEST(TransferRunTest, MethodNamesRoundTrip) {
-  for (const Method m : {Method::kOrder1, Method::kOrder2, Method::kBatch}) EXPECT_EQ(ParseMethod(MethodName(m)), m);
+  for (const Method m : {Method::kOrder1, Method::kOrder2, Method::kHistory, Method::kBatch}) {
+    EXPECT_EQ(ParseMethod(MethodName(m)), m);
+  }
   EXPECT_THROW(ParseMethod("order3"), std::invalid_argument);
 }
 
