@@ -8,7 +8,7 @@
 // each solve at the new tau), the attitude and velocity matching residuals of
 // problems/transfer_alignment/delay_model.h (second order, master derivatives kCentral; the delay enters through the
 // compensation series, which is differentiable in tau) whitened by the master noise,
-// plus bias priors. The initial values come from the order-2 filter. Standard deviations
+// plus bias priors. The initial values come from a filter run (RunMethod: the history filter). Standard deviations
 // of the misalignment and the delay from ceres::Covariance. The matching residual
 // functor lives in problems/transfer_alignment/transfer_match.h (AutoDiff; checked against central
 // differences).
@@ -51,7 +51,7 @@ struct TransferBatchSolution {
   double run_time_s = 0.0;
 };
 
-/// Solves the batch, starting from `start` (normally the order-2 filter run on the same
+/// Solves the batch, starting from `start` (RunMethod: the history filter run on the same
 /// inputs). Throws std::runtime_error if Ceres fails or the covariance is rank-deficient.
 TransferBatchSolution SolveTransferBatch(const TransferInputs& inputs, const TransferConfig& config,
                                          const TransferFilterRun& start);
