@@ -263,7 +263,8 @@ class HistoryFilter {
   }
 
   /// The iterated update with record kin (history_filter.h); r0, nis0: the residual and the
-  /// normalised innovation squared at the prior estimate. False (nothing changed) when the data time lies outside the history.
+  /// normalised innovation squared at the prior estimate. False (nothing changed) when the
+  /// data time lies outside the history.
   bool Correct(const MasterKinematics& kin, Eigen::Matrix<double, 6, 1>* r0, double* nis0) {
     const int N = static_cast<int>(P_.rows());
     const Vector6 inv_sigma = (Vector6() << Vector3d::Constant(cfg_.master_velocity_mps),
