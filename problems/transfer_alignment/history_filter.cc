@@ -302,8 +302,9 @@ class HistoryFilter {
         HPHt.noalias() += H.middleCols(col, len[g]).lazyProduct(PHt.middleRows(idx[g], len[g]));
       }
       S.compute(HPHt);
-      if (it == 0) *nis0 = y.dot(S.solve(y));
-      const VectorXd dx_next = PHt * S.solve(y);
+      const Vector6 S_inv_y = S.solve(y);
+      if (it == 0) *nis0 = y.dot(S_inv_y);
+      const VectorXd dx_next = PHt * S_inv_y;
       if (!dx_next.allFinite()) Fail(kin.tag_s, "the iterated correction");
       // The linearisation point moved by less than the model's nonlinearity can feel (the
       // delay by 1 us, attitudes by 1 urad): a further iteration would give the same.
