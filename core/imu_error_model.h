@@ -27,6 +27,20 @@ constexpr int kGSensitivityParameters = 9;
 /// Index of the misalignment entry (row, col), row != col, within a triad block.
 constexpr int MisalignmentIndex(int row, int col) { return 3 + 2 * row + (col > row ? col - 1 : col); }
 
+/// d(M x)/d(m) for the six misalignment entries of a triad block (m in their block order,
+/// entry (row, col) at MisalignmentIndex(row, col) - 3): the entry (r, c) moves row r by x_c.
+/// The estimators that linearise M at zero use it (factors/imu_preintegration.h, the
+/// transfer-alignment history filter).
+inline Eigen::Matrix<double, 3, 6> MisalignmentColumns(const Eigen::Vector3d& x) {
+  Eigen::Matrix<double, 3, 6> K = Eigen::Matrix<double, 3, 6>::Zero();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      if (c != r) K(r, MisalignmentIndex(r, c) - 3) = x(c);
+    }
+  }
+  return K;
+}
+
 /// K = I + diag(s) + M from a triad block.
 template <typename T>
 Eigen::Matrix<T, 3, 3> TriadMatrix(const T* triad) {

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "core/earth.h"
+#include "core/imu_error_model.h"
 #include "core/rotation.h"
 #include "factors/position_manifold.h"
 
@@ -335,7 +336,7 @@ void ImuPreintegration::Reintegrate(const ImuErrors& lin) {
 //   J_bg <- A J_bg - B_g D_g dt,        J_ba <- A J_ba - B_a D_a dt,
 //   J_sg <- A J_sg - B_g D_g diag(a),   J_sa <- A J_sa - B_a D_a diag(u)
 // and, at zero axis misalignment, a change mg by -D_g K(a) mg with K(a) the 3x6 matrix of
-// AxisMisalignmentColumns (core/imu_errors.h) ((I + S + M)^-1 = D - D M D + O(M^2)), so
+// MisalignmentColumns (core/imu_error_model.h) ((I + S + M)^-1 = D - D M D + O(M^2)), so
 //   J_mg <- A J_mg - B_g D_g K(a),      J_ma <- A J_ma - B_a D_a K(u)
 // (exact derivatives of the discrete recursion). The noise densities are taken for the
 // corrected sample (the D_g^2 on the raw noise is 1 - 2 sg, 0.4 % for 2000 ppm, left out).
@@ -377,8 +378,8 @@ void ImuPreintegration::Propagate(const ImuSample& sample) {
   J_sg_ = A * J_sg_ - B_g * Dg.cwiseProduct(a).asDiagonal();
   J_sa_ = A * J_sa_ - B_a * Da.cwiseProduct(u).asDiagonal();
   if (track_misalignment_) {
-    J_mg_ = A * J_mg_ - B_g * Dg.asDiagonal() * AxisMisalignmentColumns(a);
-    J_ma_ = A * J_ma_ - B_a * Da.asDiagonal() * AxisMisalignmentColumns(u);
+    J_mg_ = A * J_mg_ - B_g * Dg.asDiagonal() * MisalignmentColumns(a);
+    J_ma_ = A * J_ma_ - B_a * Da.asDiagonal() * MisalignmentColumns(u);
   }
 
   Matrix9d Q = gyro_arw_ * gyro_arw_ * dt * B_g * B_g.transpose();

@@ -16,8 +16,8 @@
 //   dp likewise (dbg = bg - bg_lin, ...).
 // Optionally (TrackAxisMisalignment) also the triads' axis misalignments, linearised at zero:
 // omega_meas = (I + S_g + M_g) omega_true + bg with M_g's six off-diagonal entries
-// mg = (M01, M02, M10, M12, M20, M21) (M_ij: axis i's sensitivity to axis j, as the
-// simulator's model, docs/imu-error-model.md), likewise M_a; they add J_R_mg mg to the
+// mg = (M01, M02, M10, M12, M20, M21) (M_ij: axis i's sensitivity to axis j; the order of
+// core/imu_error_model.h's triad block, as the simulator's model), likewise M_a; they add J_R_mg mg to the
 // rotation's exponent, J_v_mg mg + J_v_ma ma to dv and the same to dp.
 // Covariance of (dphi, dv, dp), dR_meas = dR_true Exp(dphi) (dphi in body axes at j; dv,
 // dp in body axes at i), from white gyro and accelerometer noise: ARW^2 and VRW^2 per

@@ -44,6 +44,7 @@
 #include "factors/imu_preintegration.h"
 #include "factors/position_manifold.h"
 #include "factors/state_prior.h"
+#include "problems/calibration/imu_calibration.h"
 #include "problems/transfer_alignment/transfer_match.h"
 #include "problems/transfer_alignment/master.h"
 #include "solvers/batch_driver.h"
@@ -140,8 +141,9 @@ class TransferBatch {
     double* x;
     int size;
     double sigma;
-    int offset;
-    const char* name;
+    int offset;         ///< istate offset (filter_model.h)
+    const char* triad;  ///< "gyro" or "accel"
+    int first_index;    ///< of its first entry in core/imu_error_model.h's triad block
   };
   std::vector<InstrumentBlock> InstrumentBlocks();
 
@@ -330,10 +332,11 @@ void TransferBatch::BuildProblem() {
 }
 
 std::vector<TransferBatch::InstrumentBlock> TransferBatch::InstrumentBlocks() {
-  return {{sg_.data(), 3, cfg_.gyro_scale_factor, 0, "gyro scale factor"},
-          {sa_.data(), 3, cfg_.accel_scale_factor, 3, "accelerometer scale factor"},
-          {mg_.data(), 6, cfg_.gyro_axis_misalignment_rad, 6, "gyro axis misalignment"},
-          {ma_.data(), 6, cfg_.accel_axis_misalignment_rad, 12, "accelerometer axis misalignment"}};
+  const InstrumentPrior sigma = InstrumentPriorSigma(cfg_);
+  return {{sg_.data(), 3, sigma(istate::kSg), istate::kSg, "gyro", 0},
+          {mg_.data(), 6, sigma(istate::kMg), istate::kMg, "gyro", 3},
+          {sa_.data(), 3, sigma(istate::kSa), istate::kSa, "accel", 0},
+          {ma_.data(), 6, sigma(istate::kMa), istate::kMa, "accel", 3}};
 }
 
 void TransferBatch::InstrumentPriors() {
@@ -370,15 +373,13 @@ void TransferBatch::Covariance(TransferBatchSolution* out) {
   out->delay_sigma_s = std::sqrt(std::max(0.0, P(3, 3)));
   out->misalignment_delay_covariance = P.topLeftCorner<4, 4>();
   // The instrument errors: sigma, and those the record leaves at their prior.
-  static const char* kAxes[6] = {"xy", "xz", "yx", "yz", "zx", "zy"};
   int row = 4;
   for (const InstrumentBlock& b : estimated) {
     for (int k = 0; k < b.size; ++k, ++row) {
       const double sigma = std::sqrt(std::max(0.0, P(row, row)));
       out->instrument_sigma[b.offset + k] = sigma;
       if (sigma > kNotObservableRatio * b.sigma) {
-        out->instrument_not_observable.push_back(std::string(b.name) + " " +
-                                                 (b.size == 3 ? std::string(1, "xyz"[k]) : std::string(kAxes[k])));
+        out->instrument_not_observable.push_back(calibration::TriadParameterName(b.triad, b.first_index + k));
       }
     }
   }

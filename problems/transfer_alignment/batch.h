@@ -40,10 +40,11 @@ struct TransferBatchSolution {
   Eigen::Vector3d gyro_scale_factor = Eigen::Vector3d::Zero(), accel_scale_factor = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, 6, 1> gyro_axis_misalignment_rad = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> accel_axis_misalignment_rad = Eigen::Matrix<double, 6, 1>::Zero();
-  /// sigma of [gyro scale factors (3), accel scale factors (3), gyro misalignments (6), accel (6)].
-  Eigen::Matrix<double, 18, 1> instrument_sigma = Eigen::Matrix<double, 18, 1>::Zero();
-  /// The instrument errors the record does not determine: named ("gyro scale factor x", ...)
-  /// when their posterior sigma is above 0.9 of the prior's.
+  /// sigma of the instrument errors, in filter_model.h's istate layout (per triad: scale
+  /// factors, misalignments; gyro, then accelerometer).
+  Eigen::Matrix<double, kInstrumentStates, 1> instrument_sigma = Eigen::Matrix<double, kInstrumentStates, 1>::Zero();
+  /// The instrument errors the record does not determine: named as TriadParameterName
+  /// ("accel.scale_factor.x", ...) when their posterior sigma is above 0.9 of the prior's.
   std::vector<std::string> instrument_not_observable;
   std::vector<NavState> states;  ///< the smoothed slave states (attitude R_n_s)
   int iterations = 0;

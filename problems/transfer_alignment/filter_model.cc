@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/earth.h"
-#include "core/imu_errors.h"
+#include "core/imu_error_model.h"
 #include "core/imu_split.h"
 #include "problems/ins/ins_state.h"
 
@@ -78,6 +78,15 @@ TransferVector TransferProcessNoise(const TransferConfig& c) {
   return q;
 }
 
+InstrumentPrior InstrumentPriorSigma(const TransferConfig& c) {
+  InstrumentPrior sd;
+  sd.segment<3>(istate::kSg).setConstant(c.gyro_scale_factor);
+  sd.segment<6>(istate::kMg).setConstant(c.gyro_axis_misalignment_rad);
+  sd.segment<3>(istate::kSa).setConstant(c.accel_scale_factor);
+  sd.segment<6>(istate::kMa).setConstant(c.accel_axis_misalignment_rad);
+  return sd;
+}
+
 void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatrix* F,
                            InstrumentColumns* F_instrument) {
   using tstate::kAtt;
@@ -98,9 +107,9 @@ void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatr
   const Eigen::Matrix3d F_vel_ba = F15.block<3, 3>(ins::err::kVel, ins::err::kBa);
   F_instrument->setZero();
   F_instrument->block<3, 3>(kAtt, istate::kSg) = F_att_bg * w_s.asDiagonal();
-  F_instrument->block<3, 6>(kAtt, istate::kMg) = F_att_bg * AxisMisalignmentColumns(w_s);
+  F_instrument->block<3, 6>(kAtt, istate::kMg) = F_att_bg * MisalignmentColumns(w_s);
   F_instrument->block<3, 3>(kVel, istate::kSa) = F_vel_ba * f_s.asDiagonal();
-  F_instrument->block<3, 6>(kVel, istate::kMa) = F_vel_ba * AxisMisalignmentColumns(f_s);
+  F_instrument->block<3, 6>(kVel, istate::kMa) = F_vel_ba * MisalignmentColumns(f_s);
 }
 
 TransferMatrix TransferErrorDynamics(const NavState& nav, const ImuSample& s) {

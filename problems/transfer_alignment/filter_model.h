@@ -58,21 +58,28 @@ TransferVector TransferInitialSigma(const TransferConfig& config);
 /// Continuous process-noise PSD per state (header comment).
 TransferVector TransferProcessNoise(const TransferConfig& config);
 
-/// The slave triads' instrument errors as filter states (history_filter.h):
-/// [sg (3), sa (3), mg (6), ma (6)], scale factors and axis misalignments
-/// (core/imu_errors.h), random constants.
+/// The slave triads' instrument errors as filter states (history_filter.h): per triad its
+/// scale factors s (3) and axis misalignments M (6) in the order of core/imu_error_model.h's
+/// triad block (whose first 9 entries they are, so TriadMatrix reads them), gyro then
+/// accelerometer; random constants.
 constexpr int kInstrumentStates = 18;
 using InstrumentColumns = Eigen::Matrix<double, kTransferStates, kInstrumentStates>;
 namespace istate {
-constexpr int kSg = 0;
-constexpr int kSa = 3;
-constexpr int kMg = 6;
-constexpr int kMa = 12;
+constexpr int kSg = 0;   ///< gyro triad: scale factors, then
+constexpr int kMg = 3;   ///< its misalignments
+constexpr int kSa = 9;   ///< accelerometer triad: scale factors, then
+constexpr int kMa = 12;  ///< its misalignments
 }  // namespace istate
+
+using InstrumentPrior = Eigen::Matrix<double, kInstrumentStates, 1>;
+
+/// The prior sigma of each instrument error (istate layout) from the configuration's
+/// gyro/accel scale-factor and axis-misalignment sigmas.
+InstrumentPrior InstrumentPriorSigma(const TransferConfig& config);
 
 /// F as below and d(dx_dot)/d(instrument errors) (10 x 18): a gyro error matrix E_g acts as
 /// a bias E_g omega, so its columns are F's gyro-bias columns (ins::ErrorDynamicsF) times
-/// diag(omega) (sg) and AxisMisalignmentColumns(omega) (mg); the accelerometer's likewise
+/// diag(omega) (sg) and MisalignmentColumns(omega) (mg); the accelerometer's likewise
 /// with f. omega and f from the sample (already corrected for the current estimates).
 void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatrix* F,
                            InstrumentColumns* F_instrument);

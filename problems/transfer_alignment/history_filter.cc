@@ -11,10 +11,9 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
-#include <Eigen/LU>
 
 #include "core/rotation.h"
-#include "core/imu_errors.h"
+#include "core/imu_error_model.h"
 #include "core/strapdown.h"
 #include "problems/transfer_alignment/filter_model.h"
 #include "problems/transfer_alignment/master.h"
@@ -35,7 +34,7 @@ using tstate::kVel;
 constexpr int kCloneSize = 6;  // [dv, phi] of the slave at the clone's time
 constexpr int kInstr = kTransferStates;                        // offset of the instrument errors
 constexpr int kPresent = kTransferStates + kInstrumentStates;  // the present's block
-using InstrumentVector = Eigen::Matrix<double, kInstrumentStates, 1>;
+using InstrumentVector = InstrumentPrior;  // same shape: the estimates
 constexpr int kHistoryIterations = 3;
 constexpr double kSettledDelay_s = 1e-6;
 constexpr double kSettledAngle_rad = 1e-6;  // also m/s for the velocity entries
@@ -71,7 +70,7 @@ class HistoryFilter {
     misalignment_ = in.misalignment_guess.normalized();
     tau_s_ = cfg.delay_initial_s;
     Eigen::Matrix<double, kPresent, 1> sd;
-    sd << TransferInitialSigma(cfg), InstrumentSigma(cfg);
+    sd << TransferInitialSigma(cfg), InstrumentPriorSigma(cfg);
     P_ = MatrixXd(sd.cwiseAbs2().asDiagonal());
     acc_xx_.setIdentity();
     acc_xi_.setZero();
@@ -92,21 +91,12 @@ class HistoryFilter {
   std::size_t clones() const { return clone_t_.size(); }
   static int CloneOffset(std::size_t j) { return kPresent + kCloneSize * static_cast<int>(j); }
 
-  static InstrumentVector InstrumentSigma(const TransferConfig& c) {
-    InstrumentVector sd;
-    sd.segment<3>(istate::kSg).setConstant(c.gyro_scale_factor);
-    sd.segment<3>(istate::kSa).setConstant(c.accel_scale_factor);
-    sd.segment<6>(istate::kMg).setConstant(c.gyro_axis_misalignment_rad);
-    sd.segment<6>(istate::kMa).setConstant(c.accel_axis_misalignment_rad);
-    return sd;
-  }
-
-  /// The raw sample corrected for the estimated scale factors and axis misalignments.
+  /// The raw sample corrected for the estimated scale factors and axis misalignments:
+  /// K^-1 x with K = I + diag(s) + M (core/imu_error_model.h), K^-1 kept from the last update.
   ImuSample CorrectInstrument(const ImuSample& raw) const {
     ImuSample c = raw;
-    const auto& e = instrument_;
-    c.dtheta_b_rad = TriadErrorMatrix(e.segment<3>(istate::kSg), e.segment<6>(istate::kMg)).lu().solve(raw.dtheta_b_rad);
-    c.dv_b_mps = TriadErrorMatrix(e.segment<3>(istate::kSa), e.segment<6>(istate::kMa)).lu().solve(raw.dv_b_mps);
+    c.dtheta_b_rad = gyro_correction_ * raw.dtheta_b_rad;
+    c.dv_b_mps = accel_correction_ * raw.dv_b_mps;
     return c;
   }
 
@@ -330,6 +320,8 @@ class HistoryFilter {
     misalignment_ = ApplyAttitudeError<double>(Vector3d(dx.segment<3>(kMis)), misalignment_);
     tau_s_ += dx(kTau);
     instrument_ += dx.segment<kInstrumentStates>(kInstr);
+    gyro_correction_ = TriadMatrix(instrument_.data() + istate::kSg).inverse();
+    accel_correction_ = TriadMatrix(instrument_.data() + istate::kSa).inverse();
     if (!s.v_n_mps.allFinite() || !s.q_n_b.coeffs().allFinite() || !std::isfinite(tau_s_)) Fail(t_s, "the slave state");
     ins_.SetState(s);
     const auto node_error = [&](std::size_t j) -> Vector6 {
@@ -368,7 +360,9 @@ class HistoryFilter {
   TransferMatrix acc_xx_;
   InstrumentColumns acc_xi_;
   TransferMatrix acc_q_;
-  InstrumentVector instrument_ = InstrumentVector::Zero();  // estimated [sg, sa, mg, ma]
+  InstrumentVector instrument_ = InstrumentVector::Zero();  // estimated, istate layout
+  Matrix3d gyro_correction_ = Matrix3d::Identity();         // TriadMatrix(gyro)^-1
+  Matrix3d accel_correction_ = Matrix3d::Identity();        // TriadMatrix(accel)^-1
   std::deque<double> clone_t_;
   std::deque<double> node_t_;  // times of nodes_, for the searches
   std::deque<SlaveNode> nodes_;

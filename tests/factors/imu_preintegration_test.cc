@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "core/earth.h"
+#include "core/imu_error_model.h"
 #include "core/imu_split.h"
 #include "core/rotation.h"
 #include "core/sim/random.h"
@@ -437,7 +438,13 @@ TEST(ImuPreintegration, FactorCorrectsScaleFactorsToFirstOrder) {
 std::vector<ImuSample> WithInstrumentErrors(const std::vector<ImuSample>& truth_samples, const ImuErrors& lin,
                                             const Eigen::Matrix<double, 6, 1>& mg,
                                             const Eigen::Matrix<double, 6, 1>& ma) {
-  const Eigen::Matrix3d Eg = TriadErrorMatrix(lin.sg, mg), Ea = TriadErrorMatrix(lin.sa, ma);
+  // Triad blocks of core/imu_error_model.h: scale factors, misalignments (bias apart).
+  double gyro[kTriadParameters] = {}, accel[kTriadParameters] = {};
+  Eigen::Map<Eigen::Vector3d>{gyro} = lin.sg;
+  Eigen::Map<Eigen::Matrix<double, 6, 1>>(gyro + 3) = mg;
+  Eigen::Map<Eigen::Vector3d>{accel} = lin.sa;
+  Eigen::Map<Eigen::Matrix<double, 6, 1>>(accel + 3) = ma;
+  const Eigen::Matrix3d Eg = TriadMatrix(gyro), Ea = TriadMatrix(accel);
   std::vector<ImuSample> out = truth_samples;
   for (ImuSample& x : out) {
     x.dtheta_b_rad = Eg * x.dtheta_b_rad + lin.bg_radps * x.dt_s;

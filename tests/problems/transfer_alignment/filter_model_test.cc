@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/imu_errors.h"
+#include "core/imu_error_model.h"
 #include "core/rotation.h"
 #include "core/strapdown.h"
 
@@ -20,8 +20,8 @@ namespace transfer_filter_model_test {
 Eigen::Matrix<double, 6, 1> StepError(const NavState& start, const ImuSample& exact,
                                       const Eigen::Matrix<double, kInstrumentStates, 1>& e) {
   ImuSample measured = exact;
-  measured.dtheta_b_rad = TriadErrorMatrix(e.segment<3>(istate::kSg), e.segment<6>(istate::kMg)) * exact.dtheta_b_rad;
-  measured.dv_b_mps = TriadErrorMatrix(e.segment<3>(istate::kSa), e.segment<6>(istate::kMa)) * exact.dv_b_mps;
+  measured.dtheta_b_rad = TriadMatrix(e.data() + istate::kSg) * exact.dtheta_b_rad;
+  measured.dv_b_mps = TriadMatrix(e.data() + istate::kSa) * exact.dv_b_mps;
   Strapdown truth(start), estimate(start);
   truth.Update(exact);
   estimate.Update(measured);
