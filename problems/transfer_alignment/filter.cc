@@ -116,9 +116,9 @@ class TransferFilter {
       if (it + 1 == kUpdateIterations) break;
       const Eigen::MatrixXd& P = kf_.P();
       const Eigen::MatrixXd S = Hw * P * Hw.transpose() + Eigen::MatrixXd::Identity(6, 6);
-      const Eigen::LDLT<Eigen::MatrixXd> S_ldlt(S);
-      if (it == 0) nis0 = y.dot(S_ldlt.solve(y));
-      dx_i = P * Hw.transpose() * S_ldlt.solve(y);
+      const Eigen::VectorXd S_inv_y = S.ldlt().solve(y);
+      if (it == 0) nis0 = y.dot(S_inv_y);
+      dx_i = P * Hw.transpose() * S_inv_y;
       if (!dx_i.allFinite()) Fail(kin.tag_s, "the iterated correction");
     }
     r = r0;

@@ -112,14 +112,13 @@ void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatr
   F_instrument->block<3, 6>(kVel, istate::kMa) = F_vel_ba * MisalignmentColumns(f_s);
 }
 
-TransferMatrix TransferErrorDynamics(const NavState& nav, const ImuSample& s) {
+TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s, InstrumentColumns* phi_instrument) {
   TransferMatrix F;
-  TransferErrorDynamics(nav, s, &F, nullptr);
-  return F;
-}
-
-TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s) {
-  const TransferMatrix Fdt = TransferErrorDynamics(nav, s) * s.dt_s;
+  InstrumentColumns Fi;
+  TransferErrorDynamics(nav, s, &F, phi_instrument != nullptr ? &Fi : nullptr);
+  const double dt = s.dt_s;
+  const TransferMatrix Fdt = F * dt;
+  if (phi_instrument != nullptr) *phi_instrument = Fi * dt + 0.5 * Fdt * Fi * dt;
   return TransferMatrix::Identity() + Fdt + 0.5 * Fdt * Fdt;
 }
 

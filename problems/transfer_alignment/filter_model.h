@@ -84,12 +84,12 @@ InstrumentPrior InstrumentPriorSigma(const TransferConfig& config);
 void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatrix* F,
                            InstrumentColumns* F_instrument);
 
-/// F of the error state over one IMU sample s from the nominal slave state nav (at the
-/// sample's start): the dv/phi block of ins::ErrorDynamicsF, zero elsewhere.
-TransferMatrix TransferErrorDynamics(const NavState& nav, const ImuSample& s);
-
-/// Transition over the sample: Phi = I + F dt + (F dt)^2 / 2 with F above.
-TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s);
+/// Transition over one IMU sample s from the nominal slave state nav (at the sample's
+/// start): Phi = I + F dt + (F dt)^2 / 2 with F the dv/phi block of ins::ErrorDynamicsF
+/// (zero elsewhere); with phi_instrument, also the instrument errors' columns of the same
+/// second-order transition, Phi_xi = F_xi dt + F F_xi dt^2 / 2 (their own block is I).
+TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s,
+                                  InstrumentColumns* phi_instrument = nullptr);
 
 /// The slave position set from the master record carried forward over tau with its
 /// velocity (local NED offset v tau on the ellipsoid's radii; metres of error at most,

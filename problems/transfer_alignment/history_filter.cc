@@ -37,7 +37,8 @@ constexpr int kPresent = kTransferStates + kInstrumentStates;  // the present's 
 using InstrumentVector = InstrumentPrior;  // same shape: the estimates
 constexpr int kHistoryIterations = 3;
 constexpr double kSettledDelay_s = 1e-6;
-constexpr double kSettledAngle_rad = 1e-6;  // also m/s for the velocity entries
+constexpr double kSettledAngle_rad = 1e-6;
+constexpr double kSettledVelocity_mps = 1e-6;
 // Spacing of the clones (s): the error between two clones is interpolated linearly, and the
 // error state changes little over it (f x phi dt: 50 m/s^2 x 0.1 mrad x 0.05 s = 0.25 mm/s).
 constexpr double kCloneSpacing_s = 0.1;
@@ -106,9 +107,8 @@ class HistoryFilter {
     nodes_.push_back({s.t_s, s.q_n_b, s.v_n_mps});
   }
 
-  // Phi = I + F dt + (F dt)^2 / 2 over the present [x (10), instrument errors (18)] with
-  // F = [[F_xx, F_xi], [0, 0]]: Phi_xx = I + F_xx dt + (F_xx dt)^2 / 2,
-  // Phi_xi = F_xi dt + F_xx F_xi dt^2 / 2, Phi_ii = I. P is not touched per sample: the
+  // The present [x (10), instrument errors (18)] moves with [[Phi_xx, Phi_xi], [0, I]]
+  // (filter_model.h TransferTransition). P is not touched per sample: the
   // product of the transitions since the last update, [[A, B], [0, I]], and the process
   // noise carried through them, Q_acc, are accumulated, and applied once at the next
   // update (FlushPropagation) -- the same result as sample by sample, at a fraction of the
@@ -116,12 +116,8 @@ class HistoryFilter {
   void Propagate(const ImuSample& raw) {
     const ImuSample s = CorrectInstrument(raw);
     const double dt = s.dt_s;
-    TransferMatrix F;
-    InstrumentColumns Fi;
-    TransferErrorDynamics(ins_.state(), s, &F, &Fi);
-    const TransferMatrix Fdt = F * dt;
-    const TransferMatrix phi_xx = TransferMatrix::Identity() + Fdt + 0.5 * Fdt * Fdt;
-    const InstrumentColumns phi_xi = Fi * dt + 0.5 * Fdt * Fi * dt;
+    InstrumentColumns phi_xi;
+    const TransferMatrix phi_xx = TransferTransition(ins_.state(), s, &phi_xi);
     acc_xi_ = phi_xx * acc_xi_ + phi_xi;
     acc_xx_ = phi_xx * acc_xx_;
     acc_q_ = phi_xx * acc_q_ * phi_xx.transpose();
@@ -298,8 +294,10 @@ class HistoryFilter {
       if (!dx_next.allFinite()) Fail(kin.tag_s, "the iterated correction");
       // The linearisation point moved by less than the model's nonlinearity can feel (the
       // delay by 1 us, attitudes by 1 urad): a further iteration would give the same.
-      const bool settled = it > 0 && std::abs(dx_next(kTau) - dx(kTau)) < kSettledDelay_s &&
-                           (dx_next - dx).segment<kTransferStates - 1>(0).cwiseAbs().maxCoeff() < kSettledAngle_rad;
+      const VectorXd step = dx_next - dx;
+      const bool settled = it > 0 && std::abs(step(kTau)) < kSettledDelay_s &&
+                           step.segment<3>(kVel).cwiseAbs().maxCoeff() < kSettledVelocity_mps &&
+                           step.segment<6>(kAtt).cwiseAbs().maxCoeff() < kSettledAngle_rad;  // phi and mu
       dx = dx_next;
       if (settled) break;
     }

@@ -12,6 +12,7 @@
 // target ends the program abnormally, which is the finding.
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -36,9 +37,17 @@ std::vector<std::filesystem::path> InputsIn(const std::filesystem::path& folder)
   return inputs;
 }
 
-std::vector<std::uint8_t> Bytes(const std::filesystem::path& file) {
+/// The file's bytes, at most max_bytes of them (the data logs are megabytes; a seed is their head).
+std::vector<std::uint8_t> Bytes(const std::filesystem::path& file,
+                                std::size_t max_bytes = std::numeric_limits<std::size_t>::max()) {
   std::ifstream in(file, std::ios::binary);
-  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  std::vector<std::uint8_t> bytes;
+  char chunk[4096];
+  while (bytes.size() < max_bytes && in.read(chunk, sizeof chunk).gcount() > 0) {
+    const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(in.gcount()), max_bytes - bytes.size());
+    bytes.insert(bytes.end(), chunk, chunk + n);
+  }
+  return bytes;
 }
 
 constexpr std::size_t kDataHead = 8192;
@@ -55,9 +64,9 @@ bool DataSeed(const std::string& spec, std::vector<std::uint8_t>* bytes) {
   const std::size_t plus = spec.find('+');
   const std::filesystem::path file = DataDir() / spec.substr(0, plus);
   if (!std::filesystem::is_regular_file(file)) return false;
-  *bytes = Bytes(file);
   const bool binary = file.extension() == ".ulg";
   const std::size_t head = binary ? kBinaryHead : kDataHead;
+  *bytes = Bytes(file, head + 1);
   if (bytes->size() > head) {
     bytes->resize(head);
     while (!binary && !bytes->empty() && bytes->back() != '\n') bytes->pop_back();
