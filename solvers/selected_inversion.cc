@@ -109,20 +109,26 @@ IndexMatrix PermutedNormalUpper(const ceres::CRSMatrix& crs, const ColumnBlocks&
   for (std::size_t k = 0; k < b.first.size(); ++k) {
     for (int i = 0; i < b.size[k]; ++i) block_at[b.new_first[k] + i] = static_cast<int>(k);
   }
+  // Per block, the adjacent blocks earlier in the order, by position: the same for each of
+  // its columns, so found once.
+  std::vector<std::vector<int>> earlier(b.first.size());
+  for (std::size_t k = 0; k < b.first.size(); ++k) {
+    std::vector<std::pair<int, int>> by_position;  // (position, block)
+    for (int x : b.adjacent[k]) {
+      const int position = b.position[static_cast<std::size_t>(x)];
+      if (position < b.position[k]) by_position.emplace_back(position, x);
+    }
+    std::sort(by_position.begin(), by_position.end());
+    for (const auto& [position, x] : by_position) earlier[k].push_back(x);
+  }
   IndexMatrix H(n, n);
   Eigen::Index nnz = 0;
-  std::vector<std::pair<int, int>> earlier;  // (position, block)
   for (int pass = 0; pass < 2; ++pass) {
     nnz = 0;
     for (int j = 0; j < n; ++j) {
       const auto block = static_cast<std::size_t>(block_at[j]);
       if (pass == 1) H.outerIndexPtr()[j] = nnz;
-      earlier.clear();
-      for (int x : b.adjacent[block]) {
-        if (b.position[static_cast<std::size_t>(x)] < b.position[block]) earlier.emplace_back(b.position[static_cast<std::size_t>(x)], x);
-      }
-      std::sort(earlier.begin(), earlier.end());
-      for (const auto& [position, x] : earlier) {
+      for (int x : earlier[block]) {
         for (int i = 0; i < b.size[static_cast<std::size_t>(x)]; ++i) {
           if (pass == 1) H.innerIndexPtr()[nnz] = b.new_first[static_cast<std::size_t>(x)] + i;
           ++nnz;
