@@ -33,6 +33,8 @@ Command TransferAlignAnsflCommand();
 Command CalibrateImuCommand();
 Command CalibrateMagCommand();
 Command ReportCommand();
+Command McCommand();
+Command BoundCommand();
 
 /// Exit codes shared by all subcommands.
 constexpr int kExitOk = 0;

@@ -26,7 +26,7 @@ std::vector<Command> AllCommands() {
           SmoothCommand(),        LevelCommand(),         LevelMcCommand(),
           InflightAlignCommand(), InflightMcCommand(),    TransferAlignCommand(),
           TransferAlignAnsflCommand(), CalibrateImuCommand(), CalibrateMagCommand(),
-          ReportCommand()};
+          ReportCommand(),        McCommand(),            BoundCommand()};
 }
 
 void PrintMainHelp(const std::vector<Command>& commands) {

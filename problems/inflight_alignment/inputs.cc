@@ -115,10 +115,11 @@ InflightInputs LoadInflightInputs(const InflightFiles& files) {
   return in;
 }
 
-InflightInputs SimulateInflightInputs(const sim::Scenario& scenario, std::uint64_t seed) {
+InflightInputs SimulateInflightInputs(const sim::Scenario& scenario, std::uint64_t seed, bool perfect) {
   if (!scenario.gnss) throw std::invalid_argument("scenario " + scenario.name + " has no GNSS");
   sim::SimulationOptions options;
   options.seed = seed;
+  options.perfect = perfect;
   const sim::TemporarySimulation simulated(scenario, options, "navtwin_inflight_");
   InflightFiles files;
   files.imu = simulated.path("imu.txt");

@@ -48,6 +48,7 @@ InflightInputs LoadInflightInputs(const InflightFiles& files);
 
 /// Simulates a scenario with a seed into a fresh temporary folder, reads it back as a
 /// user would (init.nav the initial state, truth.nav the truth), removes the folder.
-InflightInputs SimulateInflightInputs(const sim::Scenario& scenario, std::uint64_t seed);
+/// `perfect`: every sensor error off (sim::SimulationOptions).
+InflightInputs SimulateInflightInputs(const sim::Scenario& scenario, std::uint64_t seed, bool perfect = false);
 
 }  // namespace navtwin::inflight

@@ -23,7 +23,51 @@ std::string KmLabel(double km) {
   return s;
 }
 
+/// The heading quantities of one method's result (see InflightMcRun).
+std::vector<mc::Quantity> HeadingQuantities(const MethodResult& r, const std::vector<double>& at_km) {
+  mc::Quantity along = mc::Quantity::Empty("heading", "arcmin", kRadToArcmin, "distance_km", {"yaw"}, at_km);
+  for (std::size_t k = 0; k < at_km.size() && k < r.error_at_km_rad.size(); ++k) {
+    along.SetDiagonal(static_cast<int>(k), &r.error_at_km_rad[k], &r.sigma_at_km_rad[k]);
+  }
+  mc::Quantity at_end = mc::Quantity::Empty("heading_final", "arcmin", kRadToArcmin, "final", {"yaw"}, {1.0});
+  at_end.SetDiagonal(0, &r.final_error_rad, &r.final_sigma_rad);
+  return {along, at_end};
+}
+
 }  // namespace
+
+mc::RunRecord InflightMcRun(const sim::Scenario& scenario, const InflightConfig& config,
+                            const std::vector<Method>& methods, const std::vector<double>& at_km,
+                            std::uint64_t seed, int run) {
+  mc::RunRecord record;
+  record.run = run;
+  record.seed = seed;
+  const InflightInputs inputs = SimulateInflightInputs(scenario, seed);
+  for (const Method m : methods) {
+    mc::MethodRecord mr;
+    mr.method = MethodName(m);
+    try {
+      const MethodResult r = RunMethod(inputs, config, m, at_km);
+      mr.run_time_s = r.run_time_s;
+      mr.quantities = HeadingQuantities(r, at_km);
+    } catch (const std::exception& e) {
+      mr.failure = e.what();
+    }
+    record.methods.push_back(std::move(mr));
+  }
+  return record;
+}
+
+mc::MethodRecord InflightBound(const sim::Scenario& scenario, const InflightConfig& config,
+                               const std::vector<double>& at_km, std::uint64_t seed) {
+  const InflightInputs inputs = SimulateInflightInputs(scenario, seed, /*perfect=*/true);
+  const MethodResult r = RunMethod(inputs, config, Method::kBatch, at_km);
+  mc::MethodRecord bound;
+  bound.method = "bound";
+  bound.run_time_s = r.run_time_s;
+  bound.quantities = HeadingQuantities(r, at_km);
+  return bound;
+}
 
 McRunNumbers NumbersOf(const MethodResult& result) {
   McRunNumbers n;

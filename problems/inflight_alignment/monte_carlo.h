@@ -15,6 +15,7 @@
 #include "core/sim/scenario.h"
 #include "problems/inflight_alignment/config.h"
 #include "problems/inflight_alignment/run.h"
+#include "solvers/mc_record.h"
 
 namespace navtwin::inflight {
 
@@ -80,5 +81,20 @@ McResult RunInflightMonteCarlo(const sim::Scenario& scenario, const InflightConf
 /// Every run's numbers of every method as CSV: run,seed,method,error_<D>km_arcmin...,
 /// final_error_arcmin,final_sigma_arcmin,run_time_s (written whole or not at all).
 void WriteMcErrorsCsv(const McResult& result, const std::string& path);
+
+/// Run `run` of `navtwin mc --problem inflight` (docs/monte-carlo.md): the scenario simulated
+/// with `seed`, each method run; quantities "heading" (error estimate - truth, arcmin, with
+/// the reported sigma) at the distances `at_km` (axis distance_km) and "heading_final" at
+/// the end of the flight (axis "final", one point). A method that throws is recorded as
+/// failed.
+mc::RunRecord InflightMcRun(const sim::Scenario& scenario, const InflightConfig& config,
+                            const std::vector<Method>& methods, const std::vector<double>& at_km,
+                            std::uint64_t seed, int run);
+
+/// The Cramér-Rao bound (docs/accuracy-bound.md): the batch's heading sigma, solved on the
+/// fixes up to each distance, from the scenario simulated with every sensor error off and
+/// the configured noise. Quantities as InflightMcRun's.
+mc::MethodRecord InflightBound(const sim::Scenario& scenario, const InflightConfig& config,
+                               const std::vector<double>& at_km, std::uint64_t seed);
 
 }  // namespace navtwin::inflight

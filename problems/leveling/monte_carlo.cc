@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -171,14 +172,48 @@ AccelWindow SimulateWindow(const MonteCarloConfig& config, int run, std::vector<
   return w;
 }
 
-MonteCarloResult RunLevelingMonteCarlo(const MonteCarloConfig& config, const LevelingOptions& options,
-                                       const MonteCarloRunOptions& run_options) {
-  const std::string invalid = ValidateMonteCarloConfig(config);
-  if (!invalid.empty()) throw std::invalid_argument("leveling Monte Carlo: " + invalid);
+namespace {
+
+/// The options every method gets in the experiment: the configured noise and vibration.
+LevelingOptions ExperimentOptions(const MonteCarloConfig& config, const LevelingOptions& options) {
   LevelingOptions method_options = options;
   method_options.accel_noise_mps2 = config.noise_mg * kMilliG_mps2;
   method_options.vib_axes = config.vib_axes;
   method_options.vib_tones = config.vib_tones;
+  return method_options;
+}
+
+}  // namespace
+
+mc::RunRecord LevelingMcRun(const MonteCarloConfig& config, const LevelingOptions& options, int run) {
+  const LevelingOptions method_options = ExperimentOptions(config, options);
+  const AccelWindow window = SimulateWindow(config, run);
+  const double roll_rad = config.true_roll_deg * kDegToRad, pitch_rad = config.true_pitch_deg * kDegToRad;
+  mc::RunRecord record;
+  record.run = run;
+  record.seed = config.seed;
+  for (int m = 0; m < kMethods; ++m) {
+    const double t0 = ThreadCpuTime_s();
+    const RunOutcome o = Outcome(kMethodFunctions[m](window, method_options), roll_rad, pitch_rad);
+    mc::MethodRecord mr;
+    mr.method = kMethodNames[m];
+    mr.run_time_s = ThreadCpuTime_s() - t0;
+    mc::Quantity q = mc::Quantity::Empty("level", "deg", kRadToDeg, "final", {"roll", "pitch"}, {config.window_s});
+    const double e[2] = {o.roll_error_rad, o.pitch_error_rad};
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    const double sigma[2] = {o.roll_sigma_rad > 0.0 ? o.roll_sigma_rad : nan, o.pitch_sigma_rad > 0.0 ? o.pitch_sigma_rad : nan};
+    q.SetDiagonal(0, e, sigma);
+    mr.quantities.push_back(std::move(q));
+    record.methods.push_back(std::move(mr));
+  }
+  return record;
+}
+
+MonteCarloResult RunLevelingMonteCarlo(const MonteCarloConfig& config, const LevelingOptions& options,
+                                       const MonteCarloRunOptions& run_options) {
+  const std::string invalid = ValidateMonteCarloConfig(config);
+  if (!invalid.empty()) throw std::invalid_argument("leveling Monte Carlo: " + invalid);
+  const LevelingOptions method_options = ExperimentOptions(config, options);
   const double roll_rad = config.true_roll_deg * kDegToRad, pitch_rad = config.true_pitch_deg * kDegToRad;
 
   const int workers = MonteCarloWorkers(config.runs, config.threads);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "problems/leveling/leveling.h"
+#include "solvers/mc_record.h"
 #include "solvers/monte_carlo.h"
 
 namespace navtwin::leveling {
@@ -102,5 +103,11 @@ struct MonteCarloRunOptions {
 /// of a method stops the runs and passes through.
 MonteCarloResult RunLevelingMonteCarlo(const MonteCarloConfig& config, const LevelingOptions& options,
                                        const MonteCarloRunOptions& run_options = {});
+
+/// Run `run` of `navtwin mc --problem leveling` (docs/monte-carlo.md): the window of
+/// SimulateWindow(config, run) levelled by every method (options as RunLevelingMonteCarlo
+/// gives them); per method the quantity "level" (roll, pitch; error estimate - truth, deg,
+/// with the reported sigma where the method gives one) at one point (axis "final").
+mc::RunRecord LevelingMcRun(const MonteCarloConfig& config, const LevelingOptions& options, int run);
 
 }  // namespace navtwin::leveling

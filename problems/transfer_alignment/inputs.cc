@@ -135,7 +135,7 @@ TransferInputs LoadTransferInputs(const TransferFiles& files) {
 }
 
 TransferInputs SimulateTransferInputs(const sim::Scenario& scenario, std::uint64_t seed,
-                                      std::optional<double> delay_override_s) {
+                                      std::optional<double> delay_override_s, bool perfect) {
   if (!scenario.master) throw std::invalid_argument("scenario " + scenario.name + " has no master section");
   sim::Scenario s = scenario;
   if (delay_override_s) {
@@ -145,6 +145,7 @@ TransferInputs SimulateTransferInputs(const sim::Scenario& scenario, std::uint64
   }
   sim::SimulationOptions options;
   options.seed = seed;
+  options.perfect = perfect;
   const sim::TemporarySimulation simulated(s, options, "navtwin_transfer_");
 
   TransferFiles files;

@@ -59,8 +59,9 @@ TransferInputs LoadTransferInputs(const TransferFiles& files);
 /// (slave), master.nav, init.nav rotated into the slave axes by the identity guess (the
 /// slave INS starts from the body attitude with the init errors: its mounting is unknown),
 /// truth.nav; the true misalignment from the scenario's imu.mounting_deg, the true delay
-/// from master.transfer_delay_s.
+/// from master.transfer_delay_s. `perfect`: every sensor error off (sim::SimulationOptions),
+/// the scenario's mounting and delay kept.
 TransferInputs SimulateTransferInputs(const sim::Scenario& scenario, std::uint64_t seed,
-                                      std::optional<double> delay_override_s = std::nullopt);
+                                      std::optional<double> delay_override_s = std::nullopt, bool perfect = false);
 
 }  // namespace navtwin::transfer

@@ -1,0 +1,180 @@
+#include "problems/gnss_ins/monte_carlo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "core/io/atomic_file.h"
+#include "core/io/open.h"
+#include "core/rotation.h"
+#include "core/sim/scenario.h"
+#include "core/sim/simulator.h"
+#include "problems/gnss_ins/batch.h"
+#include "problems/gnss_ins/config.h"
+#include "problems/gnss_ins/filter.h"
+#include "problems/gnss_ins/initial_state.h"
+#include "problems/gnss_ins/inputs.h"
+#include "problems/gnss_ins/sim_config.h"
+#include "problems/ins/ins_state.h"
+#include "problems/ins/nav_error.h"
+
+namespace navtwin::gnss_ins {
+
+namespace {
+
+constexpr double kMradPerRad = 1000.0;
+constexpr double kKnotMatch_s = 1e-6;
+
+/// A simulated record read back as `navtwin smooth` reads it.
+struct McRecord {
+  GnssInsConfig config;
+  Inputs inputs;
+  std::vector<NavState> truth;
+};
+
+McRecord SimulateMcRecord(const GnssInsMcSetup& setup, std::uint64_t seed, bool perfect) {
+  const sim::Scenario scenario = sim::LoadScenario(setup.scenario);
+  if (!scenario.gnss) throw std::invalid_argument("scenario " + setup.scenario + " has no GNSS");
+  sim::SimulationOptions options;
+  options.seed = seed;
+  options.perfect = perfect;
+  const sim::TemporarySimulation simulated(scenario, options, "navtwin_mc_");
+  AtomicFile yaml(simulated.path("navtwin.yaml"));
+  yaml.stream() << ConfigYamlForSimulation(scenario, simulated.dir(), seed, setup.mag_mode);
+  yaml.Commit();
+  McRecord r;
+  r.config = LoadGnssInsConfig(simulated.path("navtwin.yaml"));
+  InputPaths paths;
+  paths.imu = simulated.path("imu.txt");
+  paths.gnss = simulated.path("gnss.txt");
+  if (scenario.mag && setup.mag_mode != "off") paths.mag = simulated.path("mag.csv");
+  r.inputs = LoadInputs(paths, r.config);
+  const std::unique_ptr<NavReader> truth = OpenNav(simulated.path("truth.nav"));
+  NavState s;
+  while (truth->Next(&s)) r.truth.push_back(s);
+  return r;
+}
+
+std::vector<double> McGrid(const Inputs& inputs) {
+  const double t0 = inputs.imu.begin_s();
+  const double span = inputs.imu.known_end_s() - t0;
+  std::vector<double> grid;
+  for (int k = 1; k <= static_cast<int>(std::floor(span + kKnotMatch_s)); ++k) grid.push_back(t0 + k);
+  return grid;
+}
+
+struct NavQuantities {
+  mc::Quantity position, velocity, attitude;
+  explicit NavQuantities(const std::vector<double>& grid)
+      : position(mc::Quantity::Empty("position", "m", 1.0, "t_s", {"n", "e", "d"}, grid)),
+        velocity(mc::Quantity::Empty("velocity", "m/s", 1.0, "t_s", {"n", "e", "d"}, grid)),
+        attitude(mc::Quantity::Empty("attitude", "mrad", kMradPerRad, "t_s", {"n", "e", "d"}, grid)) {}
+  std::vector<mc::Quantity> Take() { return {std::move(position), std::move(velocity), std::move(attitude)}; }
+};
+
+/// Errors of the knots against the truth on the grid; covariances from `covariances` (full
+/// n x n per knot) when given, else diag(std^2).
+std::vector<mc::Quantity> QuantitiesOf(const Solution& s, const std::vector<Eigen::MatrixXd>* covariances,
+                                       const std::vector<NavState>& truth, const std::vector<double>& grid) {
+  NavQuantities q(grid);
+  std::size_t k = 0;
+  for (int p = 0; p < static_cast<int>(grid.size()); ++p) {
+    while (k < s.epochs.size() && s.epochs[k].state.nav.t_s <= grid[p] + kKnotMatch_s) ++k;
+    if (k == 0) continue;
+    const NavEpoch& knot = s.epochs[k - 1];
+    const std::optional<NavState> t = NavAt(truth, knot.state.nav.t_s);
+    if (!t || knot.std.size() < ins::err::kBa + 3) continue;
+    const NavError e = CompareNav(knot.state.nav, *t);
+    const Eigen::Vector3d e_att =
+        LogSO3(Eigen::Matrix3d((knot.state.nav.q_n_b * t->q_n_b.conjugate()).toRotationMatrix()));
+    Eigen::MatrixXd P = knot.std.array().square().matrix().asDiagonal();
+    if (covariances != nullptr && k - 1 < covariances->size()) P = (*covariances)[k - 1];
+    const auto block = [&](int at) {
+      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> b = P.block<3, 3>(at, at);
+      return b;
+    };
+    const auto pos = block(ins::err::kPos), vel = block(ins::err::kVel), att = block(ins::err::kAtt);
+    q.position.Set(p, e.pos_ned_m.data(), pos.data());
+    q.velocity.Set(p, e.vel_ned_mps.data(), vel.data());
+    q.attitude.Set(p, e_att.data(), att.data());
+  }
+  return q.Take();
+}
+
+bool Wants(const GnssInsMcSetup& setup, const std::string& method) {
+  return std::find(setup.methods.begin(), setup.methods.end(), method) != setup.methods.end();
+}
+
+}  // namespace
+
+void CheckGnssInsMcSetup(const GnssInsMcSetup& setup) {
+  for (const std::string& m : setup.methods) {
+    if (m != "filter" && m != "rts" && m != "batch") {
+      throw std::invalid_argument("gnss_ins Monte Carlo: unknown method '" + m + "' (filter, rts, batch)");
+    }
+  }
+  if (setup.methods.empty()) throw std::invalid_argument("gnss_ins Monte Carlo: no method");
+  for (const char* mode : {"off", "vector", "heading", "heading_2axis"}) {
+    if (setup.mag_mode == mode) return;
+  }
+  throw std::invalid_argument("gnss_ins Monte Carlo: unknown magnetometer mode '" + setup.mag_mode + "'");
+}
+
+mc::RunRecord GnssInsMcRun(const GnssInsMcSetup& setup, std::uint64_t seed, int run) {
+  mc::RunRecord record;
+  record.run = run;
+  record.seed = seed;
+  const McRecord r = SimulateMcRecord(setup, seed, false);
+  const std::vector<double> grid = McGrid(r.inputs);
+  mc::MethodRecord filter{"filter", "", 0.0, {}}, rts{"rts", "", 0.0, {}}, batch{"batch", "", 0.0, {}};
+  try {
+    const FilterStart start = InitialFilterState(r.inputs, r.config, nullptr);
+    const bool smooth = Wants(setup, "rts") || Wants(setup, "batch");
+    FilterResult fr = RunFilter(r.inputs, r.config, start, smooth, {}, nullptr, /*keep_covariances=*/true);
+    filter.run_time_s = fr.filter.run_time_s;
+    filter.quantities = QuantitiesOf(fr.filter, &fr.filter_covariances, r.truth, grid);
+    if (fr.rts) {
+      rts.run_time_s = fr.rts->run_time_s;
+      rts.quantities = QuantitiesOf(*fr.rts, &fr.rts_covariances, r.truth, grid);
+      if (Wants(setup, "batch")) {
+        try {
+          const Solution b = RunBatch(r.inputs, r.config, *fr.rts, &start, nullptr);
+          batch.run_time_s = b.run_time_s;
+          batch.quantities = QuantitiesOf(b, nullptr, r.truth, grid);
+        } catch (const std::exception& e) {
+          batch.failure = e.what();
+        }
+      }
+    }
+  } catch (const std::exception& e) {
+    filter.failure = rts.failure = batch.failure = e.what();
+  }
+  for (mc::MethodRecord* m : {&filter, &rts, &batch}) {
+    if (Wants(setup, m->method)) record.methods.push_back(std::move(*m));
+  }
+  return record;
+}
+
+mc::MethodRecord GnssInsBound(const GnssInsMcSetup& setup, std::uint64_t seed) {
+  McRecord r = SimulateMcRecord(setup, seed, true);
+  r.config.batch.variance_components = false;
+  r.config.batch.covariance = true;
+  const std::vector<double> grid = McGrid(r.inputs);
+  const FilterStart start = InitialFilterState(r.inputs, r.config, nullptr);
+  FilterResult fr = RunFilter(r.inputs, r.config, start, true, {}, nullptr);
+  if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
+  const Solution b = RunBatch(r.inputs, r.config, *fr.rts, &start, nullptr);
+  mc::MethodRecord bound;
+  bound.method = "bound";
+  bound.run_time_s = b.run_time_s;
+  bound.quantities = QuantitiesOf(b, nullptr, r.truth, grid);
+  return bound;
+}
+
+}  // namespace navtwin::gnss_ins
