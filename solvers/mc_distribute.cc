@@ -41,6 +41,10 @@ class RunDispenser {
     const std::lock_guard<std::mutex> lock(mutex_);
     stopped_ = true;
   }
+  bool stopped() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return stopped_;
+  }
 
  private:
   std::mutex mutex_;
@@ -221,7 +225,7 @@ void DistributeRuns(const RankSession& session, int runs, int threads,
   std::exception_ptr error;
   const auto local_worker = [&]() {
     for (std::pair<int, int> chunk = dispenser.Take(); chunk.second > 0; chunk = dispenser.Take()) {
-      for (int run = chunk.first; run < chunk.first + chunk.second; ++run) {
+      for (int run = chunk.first; run < chunk.first + chunk.second && !dispenser.stopped(); ++run) {
         try {
           order.Deliver(run, compute(run));
         } catch (...) {

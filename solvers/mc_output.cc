@@ -126,7 +126,8 @@ std::string FinalsCsv(const ExperimentInfo& info, const std::vector<MethodStatis
         for (int i = 0; i < l.dim(); ++i) {
           const std::size_t k = static_cast<std::size_t>(run) * l.dim() + i;
           if (k >= q.final_error.size()) continue;
-          out << run << "," << info.seed + run << "," << m.method << "," << l.name << "," << l.components[i] << ","
+          const std::uint64_t seed = static_cast<std::size_t>(run) < info.run_seeds.size() ? info.run_seeds[run] : info.seed + run;
+          out << run << "," << seed << "," << m.method << "," << l.name << "," << l.components[i] << ","
               << l.unit << "," << q.final_error[k] * l.scale << "," << q.final_sigma[k] * l.scale << "\n";
         }
       }
@@ -200,7 +201,7 @@ std::string SummaryJson(const ExperimentInfo& info, const std::vector<MethodStat
   JsonWriter w(out);
   w.BeginObject();
   w.Field("command", "mc").Field("problem", info.problem).Field("scenario", info.scenario);
-  w.Field("seed", static_cast<long long>(info.seed)).Field("runs", info.runs);
+  w.Field("seed", static_cast<long long>(info.seed)).Field("runs", info.runs).Field("seeding", info.seeding);
   w.Key("notes").BeginArray();
   for (const std::string& n : info.notes) w.Value(n);
   w.EndArray();
@@ -232,8 +233,7 @@ std::string SummaryJson(const ExperimentInfo& info, const std::vector<MethodStat
 std::string SummaryTable(const ExperimentInfo& info, const std::vector<MethodStatistics>& stats,
                          const MethodRecord* bound) {
   std::ostringstream out;
-  out << info.problem << " Monte Carlo: " << info.runs << " runs of " << info.scenario << ", seeds " << info.seed
-      << ".." << info.seed + static_cast<std::uint64_t>(info.runs > 0 ? info.runs - 1 : 0) << "\n";
+  out << info.problem << " Monte Carlo: " << info.runs << " runs of " << info.scenario << ", " << info.seeding << "\n";
   for (const std::string& n : info.notes) out << "  note: " << n << "\n";
   out << "final values (RMS over runs, mean reported sigma, their ratio, the Cramer-Rao bound):\n";
   out << "method         quantity           comp              rms      sigma  rms/sigma      bound  rms/bound  in 3sigma\n";

@@ -17,6 +17,10 @@ struct ExperimentInfo {
   std::string scenario;  ///< preset name or YAML path
   std::uint64_t seed = 1;  ///< run k uses seed + k
   int runs = 0;
+  std::vector<std::uint64_t> run_seeds;  ///< per run (Accumulator::seeds); empty: seed + run
+  /// How the runs draw, e.g. "seeds 1..200" or "streams 0..9999 of seed 1" (the summary's
+  /// "seeding" and the table's first line).
+  std::string seeding;
   std::vector<std::string> notes;  ///< e.g. what the bound covers, what a method leaves out
 };
 

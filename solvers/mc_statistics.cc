@@ -152,6 +152,7 @@ void Accumulator::Add(const RunRecord& record) {
       }
     }
   }
+  seeds_.push_back(record.seed);
   ++runs_;
 }
 

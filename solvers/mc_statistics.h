@@ -13,6 +13,7 @@
 // and the per-run table.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -58,6 +59,8 @@ class Accumulator {
   /// are the bound, matched by quantity name and axis point) when given.
   std::vector<MethodStatistics> Finish(const MethodRecord* bound = nullptr) const;
   int runs() const { return runs_; }
+  /// The seed of every run added, in run order.
+  const std::vector<std::uint64_t>& seeds() const { return seeds_; }
 
  private:
   struct PointSums {
@@ -78,6 +81,7 @@ class Accumulator {
   void AddQuantity(const Quantity& q, int runs_before, MethodSums* m);
 
   int runs_ = 0;
+  std::vector<std::uint64_t> seeds_;
   std::vector<MethodSums> methods_;  ///< in the order first seen
 };
 

@@ -52,6 +52,7 @@ constexpr const char* kBoundUsage =
 struct McProblem {
   std::string scenario;
   int default_runs = 100;
+  bool streams_of_one_seed = false;  ///< run k draws stream k of --seed (else seed --seed + k)
   std::function<mc::RunRecord(std::uint64_t seed, int run)> run;
   std::function<mc::MethodRecord()> bound;  ///< empty: the problem has none
   std::vector<std::string> notes;
@@ -123,6 +124,7 @@ McProblem LevelingProblem() {
   McProblem p;
   p.scenario = "leveling Monte Carlo of seed 000 (problems/leveling/monte_carlo.h)";
   p.default_runs = 10000;
+  p.streams_of_one_seed = true;
   if (!FLAGS_scenario.empty()) throw std::invalid_argument("--scenario: the leveling experiment has no scenario file");
   if (!FLAGS_methods.empty()) throw std::invalid_argument("--methods: the leveling experiment runs its four methods");
   leveling::MonteCarloConfig config;
@@ -142,16 +144,18 @@ McProblem MakeProblem(const std::string& name) {
   throw std::invalid_argument("--problem: '" + name + "' is not one of gnss_ins, transfer, inflight, leveling");
 }
 
-/// "mc: 37/200 runs, 1.93 runs/s, 84 s left", at most once a second and at the end.
-std::function<void(int, int)> ProgressLine() {
+/// "mc: 37/201 done (the last is the bound), 1.93 per s, 84 s left", at most once a second
+/// and at the end.
+std::function<void(int, int)> ProgressLine(bool with_bound) {
   const auto start = std::chrono::steady_clock::now();
   auto last = std::make_shared<double>(-1.0);
-  return [start, last](int done, int runs) {
+  const char* what = with_bound ? " done (the last is the bound)" : " runs";
+  return [start, last, what](int done, int runs) {
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (done < runs && t - *last < 1.0) return;
     *last = t;
     const double rate = done / std::max(t, 1e-9);
-    std::fprintf(stderr, "mc: %d/%d runs, %.3g runs/s, %.0f s left\n", done, runs, rate, (runs - done) / rate);
+    std::fprintf(stderr, "mc: %d/%d%s, %.3g per s, %.0f s left\n", done, runs, what, rate, (runs - done) / rate);
   };
 }
 
@@ -177,8 +181,8 @@ int RunMc(const std::vector<std::string>& args) {
   if (runs < 1) return lead ? McUsage("--runs must be >= 1") : kExitUsage;
   const bool with_bound = FLAGS_bound && static_cast<bool>(problem.bound);
   if (lead) {
-    std::cerr << "mc: " << runs << " runs of " << FLAGS_problem << " on " << problem.scenario << ", seeds "
-              << FLAGS_seed << ".." << FLAGS_seed + runs - 1 << (with_bound ? ", and the bound" : "") << "; "
+    std::cerr << "mc: " << runs << " runs of " << FLAGS_problem << " on " << problem.scenario << ", seed "
+              << FLAGS_seed << (with_bound ? ", and the bound" : "") << "; "
               << session.ranks() << " rank" << (session.ranks() == 1 ? "" : "s") << " x "
               << FLAGS_threads << " thread" << (FLAGS_threads == 1 ? "" : "s") << "\n";
   }
@@ -203,13 +207,17 @@ int RunMc(const std::vector<std::string>& args) {
       accumulator.Add(r);
     }
   };
-  mc::DistributeRuns(session, items, FLAGS_threads, compute, consume, lead ? ProgressLine() : nullptr);
+  mc::DistributeRuns(session, items, FLAGS_threads, compute, consume, lead ? ProgressLine(with_bound) : nullptr);
   if (!lead) return kExitOk;
   mc::ExperimentInfo info;
   info.problem = FLAGS_problem;
   info.scenario = problem.scenario;
   info.seed = FLAGS_seed;
   info.runs = runs;
+  info.run_seeds = accumulator.seeds();
+  info.seeding = problem.streams_of_one_seed
+                     ? "streams 0.." + std::to_string(runs - 1) + " of seed " + std::to_string(FLAGS_seed)
+                     : "seeds " + std::to_string(FLAGS_seed) + ".." + std::to_string(FLAGS_seed + runs - 1);
   info.notes = problem.notes;
   const mc::MethodRecord* bound_ptr = with_bound ? &bound : nullptr;
   const std::vector<mc::MethodStatistics> stats = accumulator.Finish(bound_ptr);

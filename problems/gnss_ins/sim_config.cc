@@ -33,6 +33,19 @@ Eigen::Vector3d VecFrom(const YAML::Node& n, const std::string& what) {
   return Eigen::Vector3d(n[0].as<double>(), n[1].as<double>(), n[2].as<double>());
 }
 
+/// The filter estimates the scale factors when the scenario draws any.
+bool EstimatesScaleFactors(const sim::TriadErrorConfig& gyro, const sim::TriadErrorConfig& accel) {
+  return gyro.scale_factor.sigma > 0.0 || accel.scale_factor.sigma > 0.0;
+}
+
+/// The scale-factor priors; a triad without scale-factor errors next to one with them gets
+/// 1 ppm (the configuration needs a positive sigma), none when neither has any.
+std::string ScaleFactorLines(const sim::TriadErrorConfig& gyro, const sim::TriadErrorConfig& accel) {
+  if (!EstimatesScaleFactors(gyro, accel)) return "";
+  const auto ppm = [](const sim::TriadErrorConfig& t) { return std::max(t.scale_factor.sigma / kPpm, 1.0); };
+  return "  gyro_scale_std_ppm: " + Num(ppm(gyro)) + "\n  accel_scale_std_ppm: " + Num(ppm(accel)) + "\n";
+}
+
 }  // namespace
 
 std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::string& sim_dir,
@@ -57,9 +70,8 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
        "  accel_vrw_m_s_sqrt_h: " << Num(accel.white_noise / kMpsPerSqrtHour_mpspsqrts) << "\n"
        "  gyro_bias_std_deg_h: " << Num(gyro.bias.sigma / kDegPerHour_radps) << "\n"
        "  accel_bias_std_ug: " << Num(accel.bias.sigma / kMicroG_mps2) << "\n"
-       "  gyro_scale_std_ppm: " << Num(gyro.scale_factor.sigma / kPpm) << "\n"
-       "  accel_scale_std_ppm: " << Num(accel.scale_factor.sigma / kPpm) << "\n"
-       "  correlation_time_s: inf   # constant turn-on biases and scale factors\n"
+    << ScaleFactorLines(gyro, accel)
+    << "  correlation_time_s: inf   # constant turn-on biases and scale factors\n"
        "installation:\n"
        "  imu_mounting_deg: " << Vec(scenario.imu.mounting_rpy_rad, kRadToDeg) << "\n"
        "  antenna_lever_arm_b_m: " << Vec(scenario.gnss->lever_arm_b_m) << "\n"
@@ -97,7 +109,7 @@ std::string ConfigYamlForSimulation(const sim::Scenario& scenario, const std::st
          "  time_offset_s: " << Num(scenario.gnss->latency_s) << "   # the receiver's latency\n";
   }
   y << "filter:\n"
-       "  scale_factors: true\n";
+       "  scale_factors: " << (EstimatesScaleFactors(gyro, accel) ? "true" : "false") << "\n";
   return y.str();
 }
 
