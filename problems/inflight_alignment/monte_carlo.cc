@@ -61,7 +61,11 @@ mc::RunRecord InflightMcRun(const sim::Scenario& scenario, const InflightConfig&
 mc::MethodRecord InflightBound(const sim::Scenario& scenario, const InflightConfig& config,
                                const std::vector<double>& at_km, std::uint64_t seed) {
   const InflightInputs inputs = SimulateInflightInputs(scenario, seed, /*perfect=*/true);
-  const MethodResult r = RunMethod(inputs, config, Method::kBatch, at_km);
+  // Noise-free fixes would estimate a zero GPS sigma: the bound takes the receiver's.
+  InflightConfig bound_config = config;
+  double& gps_sigma_m = bound_config.sensors.gps_sigma_m;
+  if (gps_sigma_m == 0.0) gps_sigma_m = scenario.gnss->position_sigma_ned_m.head<2>().mean();
+  const MethodResult r = RunMethod(inputs, bound_config, Method::kBatch, at_km);
   mc::MethodRecord bound;
   bound.method = "bound";
   bound.run_time_s = r.run_time_s;

@@ -93,7 +93,8 @@ mc::RunRecord InflightMcRun(const sim::Scenario& scenario, const InflightConfig&
 
 /// The Cramér-Rao bound (docs/accuracy-bound.md): the batch's heading sigma, solved on the
 /// fixes up to each distance, from the scenario simulated with every sensor error off and
-/// the configured noise. Quantities as InflightMcRun's.
+/// the configured noise (a GPS sigma of 0, "estimate it", becomes the scenario receiver's
+/// horizontal sigma). Quantities as InflightMcRun's.
 mc::MethodRecord InflightBound(const sim::Scenario& scenario, const InflightConfig& config,
                                const std::vector<double>& at_km, std::uint64_t seed);
 

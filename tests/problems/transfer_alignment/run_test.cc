@@ -18,6 +18,7 @@
 #include "core/config/yaml_config.h"
 #include "core/units.h"
 #include "problems/transfer_alignment/inputs.h"
+#include "tests/problems/transfer_alignment/short_scenario.h"
 
 namespace navtwin::transfer {
 namespace transfer_alignment_run_test {
@@ -164,27 +165,7 @@ TEST(TransferRunTest, MethodNamesRoundTrip) {
 /// the preset; simulated once with the delay overridden to 0.12 s.
 const TransferInputs& ShortInputs() {
   static const TransferInputs in = [] {
-    const char* yaml = R"(name: transfer-short
-start: {lat_deg: 36.0, lon_deg: 127.5, h_m: 3000}
-trajectory:
-  initial: {speed_mps: 200, heading_deg: 0}
-  segments:
-    - {kind: cruise, duration_s: 2}
-    - {kind: wing_rock, duration_s: 4, roll_amplitude_deg: 30, roll_frequency_hz: 0.5, pitch_amplitude_deg: 5, pitch_frequency_hz: 0.25, yaw_amplitude_deg: 5, yaw_frequency_hz: 0.25}
-imu:
-  rate_hz: 100
-  mounting_deg: [0.5, -0.3, 0.8]
-  errors:
-    gyro: {bias_deg_h: 1.0, arw_deg_sqrt_h: 0.05}
-    accel: {bias_ug: 200, vrw_m_s_sqrt_h: 0.05}
-master:
-  rate_hz: 50
-  transfer_delay_s: 0.3
-  attitude_error_sigma_mrad: 0.05
-  velocity_noise_mps: 0.01
-init_errors: {velocity_ned_mps: [0.5, -0.5, 0.2], attitude_deg: [0.5, -0.5, 1.0]}
-)";
-    return SimulateTransferInputs(sim::ParseScenario(ParseYaml(yaml, "transfer-short.yaml")), 1, 0.12);
+    return SimulateTransferInputs(test_scenarios::ShortTransferScenario(4.0, 0.3), 1, 0.12);
   }();
   return in;
 }
