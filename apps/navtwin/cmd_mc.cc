@@ -17,6 +17,7 @@
 #include "apps/navtwin/common_flags.h"
 #include "core/io/folder.h"
 #include "core/sim/scenario.h"
+#include "problems/calibration/monte_carlo.h"
 #include "problems/gnss_ins/monte_carlo.h"
 #include "problems/inflight_alignment/config.h"
 #include "problems/inflight_alignment/monte_carlo.h"
@@ -27,7 +28,7 @@
 #include "solvers/mc_output.h"
 #include "solvers/mc_statistics.h"
 
-DEFINE_string(problem, "", "mc, bound: gnss_ins, transfer, inflight or leveling");
+DEFINE_string(problem, "", "mc, bound: gnss_ins, transfer, inflight, leveling or calibration");
 DEFINE_string(methods, "", "mc: comma-separated methods of the problem (default: all of them)");
 DEFINE_bool(bound, true, "mc: compute the Cramer-Rao bound beside the runs (problems that have one)");
 DEFINE_bool(mpi, true, "mc: spread the runs over MPI ranks when started by mpirun or srun");
@@ -36,7 +37,7 @@ namespace navtwin::app {
 namespace {
 
 constexpr const char* kMcUsage =
-    "navtwin mc --problem gnss_ins|transfer|inflight|leveling [--scenario PRESET|YAML] [--runs N] [--seed S]\n"
+    "navtwin mc --problem gnss_ins|transfer|inflight|leveling|calibration [--scenario PRESET|YAML] [--runs N] [--seed S]\n"
     "           [--methods a,b] [--config YAML] [--threads T] [--bound=false] --out DIR [--format=json]\n"
     "  Run k simulates the scenario with seed S + k (leveling: stream k of seed S) and runs every method;\n"
     "  per method and quantity: RMS error over runs, mean reported sigma, their ratio, ANEES with its 95 %\n"
@@ -136,12 +137,25 @@ McProblem LevelingProblem() {
   return p;
 }
 
+McProblem CalibrationProblem() {
+  McProblem p;
+  calibration::CalibrationMcSetup setup;
+  setup.scenario_path = FLAGS_scenario;
+  if (!FLAGS_methods.empty()) setup.methods = SplitList(FLAGS_methods);
+  calibration::CheckCalibrationMcSetup(setup);
+  p.scenario = FLAGS_scenario;
+  p.run = [=](std::uint64_t seed, int run) { return calibration::CalibrationMcRun(setup, seed, run); };
+  p.notes.push_back("multi-position table; no bound (the estimator takes its noise from the data)");
+  return p;
+}
+
 McProblem MakeProblem(const std::string& name) {
+  if (name == "calibration") return CalibrationProblem();
   if (name == "transfer") return TransferProblem();
   if (name == "gnss_ins") return GnssInsProblem();
   if (name == "inflight") return InflightProblem();
   if (name == "leveling") return LevelingProblem();
-  throw std::invalid_argument("--problem: '" + name + "' is not one of gnss_ins, transfer, inflight, leveling");
+  throw std::invalid_argument("--problem: '" + name + "' is not one of gnss_ins, transfer, inflight, leveling, calibration");
 }
 
 /// "mc: 37/201 done (the last is the bound), 1.93 per s, 84 s left", at most once a second

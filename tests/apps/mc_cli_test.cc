@@ -84,7 +84,7 @@ TEST(McCliTest, MpirunWithTwoRanksWritesTheSameBytes) {
 TEST(McCliTest, UsageErrorsExitTwoAndWriteNothing) {
   const std::string dir = MakeTempDir("mc_usage") + "/out";
   for (const char* args : {"--problem nope", "--problem leveling --runs 0", "--problem transfer --methods order9",
-                           "--problem leveling --scenario x"}) {
+                           "--problem leveling --scenario x", "--problem calibration"}) {
     const RunResult r = Navtwin(std::string("mc ") + args + " --out " + dir);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
     EXPECT_NE(r.err.find("usage:"), std::string::npos) << args;
