@@ -15,6 +15,7 @@
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
+#include "problems/gnss_ins/adapted_noise.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/config.h"
 #include "problems/gnss_ins/filter.h"
@@ -30,6 +31,7 @@ namespace {
 
 constexpr double kMradPerRad = 1000.0;
 constexpr double kKnotMatch_s = 1e-6;
+const std::vector<std::string> kMethods = {"filter", "rts", "batch", "filter_adapted", "rts_adapted"};
 
 /// A simulated record read back as `navtwin smooth` reads it.
 struct McRecord {
@@ -111,12 +113,32 @@ bool Wants(const GnssInsMcSetup& setup, const std::string& method) {
   return std::find(setup.methods.begin(), setup.methods.end(), method) != setup.methods.end();
 }
 
+/// The filter and its RTS smoother again with the noise the batch's variance components
+/// found (adapted_noise.h), as `navtwin smooth` runs them; the plain ones when nothing changed.
+void RunAdapted(const McRecord& r, const FilterStart& start, const Solution& batch, const std::vector<double>& grid,
+                const mc::MethodRecord& filter, const mc::MethodRecord& rts, mc::MethodRecord* filter_adapted,
+                mc::MethodRecord* rts_adapted) {
+  const AdaptedNoise adapted = AdaptNoise(r.config, batch.residuals);
+  if (!adapted.changed) {
+    filter_adapted->quantities = filter.quantities;
+    rts_adapted->quantities = rts.quantities;
+    return;
+  }
+  FilterResult fr = RunFilter(r.inputs, adapted.config, start, true, {}, nullptr, /*keep_covariances=*/true);
+  filter_adapted->run_time_s = fr.filter.run_time_s;
+  filter_adapted->quantities = QuantitiesOf(fr.filter, &fr.filter_covariances, r.truth, grid);
+  if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
+  rts_adapted->run_time_s = fr.rts->run_time_s;
+  rts_adapted->quantities = QuantitiesOf(*fr.rts, &fr.rts_covariances, r.truth, grid);
+}
+
 }  // namespace
 
 void CheckGnssInsMcSetup(const GnssInsMcSetup& setup) {
   for (const std::string& m : setup.methods) {
-    if (m != "filter" && m != "rts" && m != "batch") {
-      throw std::invalid_argument("gnss_ins Monte Carlo: unknown method '" + m + "' (filter, rts, batch)");
+    if (std::find(kMethods.begin(), kMethods.end(), m) == kMethods.end()) {
+      throw std::invalid_argument("gnss_ins Monte Carlo: unknown method '" + m +
+                                  "' (filter, rts, batch, filter_adapted, rts_adapted)");
     }
   }
   if (setup.methods.empty()) throw std::invalid_argument("gnss_ins Monte Carlo: no method");
@@ -132,31 +154,35 @@ mc::RunRecord GnssInsMcRun(const GnssInsMcSetup& setup, std::uint64_t seed, int 
   record.seed = seed;
   const McRecord r = SimulateMcRecord(setup, seed, false);
   const std::vector<double> grid = McGrid(r.inputs);
-  mc::MethodRecord filter{"filter", "", 0.0, {}}, rts{"rts", "", 0.0, {}}, batch{"batch", "", 0.0, {}};
+  std::vector<mc::MethodRecord> m(kMethods.size());
+  for (std::size_t i = 0; i < kMethods.size(); ++i) m[i].method = kMethods[i];
+  mc::MethodRecord &filter = m[0], &rts = m[1], &batch = m[2];
+  const bool adapted = Wants(setup, "filter_adapted") || Wants(setup, "rts_adapted");
+  std::size_t failing_from = 0;  // methods from here on fail with the exception below
   try {
     const FilterStart start = InitialFilterState(r.inputs, r.config, nullptr);
-    const bool smooth = Wants(setup, "rts") || Wants(setup, "batch");
+    const bool smooth = Wants(setup, "rts") || Wants(setup, "batch") || adapted;
     FilterResult fr = RunFilter(r.inputs, r.config, start, smooth, {}, nullptr, /*keep_covariances=*/true);
     filter.run_time_s = fr.filter.run_time_s;
     filter.quantities = QuantitiesOf(fr.filter, &fr.filter_covariances, r.truth, grid);
+    failing_from = 1;
     if (fr.rts) {
       rts.run_time_s = fr.rts->run_time_s;
       rts.quantities = QuantitiesOf(*fr.rts, &fr.rts_covariances, r.truth, grid);
-      if (Wants(setup, "batch")) {
-        try {
-          const Solution b = RunBatch(r.inputs, r.config, *fr.rts, &start, nullptr);
-          batch.run_time_s = b.run_time_s;
-          batch.quantities = QuantitiesOf(b, nullptr, r.truth, grid);
-        } catch (const std::exception& e) {
-          batch.failure = e.what();
-        }
-      }
+    }
+    failing_from = 2;
+    if (Wants(setup, "batch") || adapted) {
+      const Solution b = RunBatch(r.inputs, r.config, *fr.rts, &start, nullptr);
+      batch.run_time_s = b.run_time_s;
+      batch.quantities = QuantitiesOf(b, nullptr, r.truth, grid);
+      failing_from = 3;
+      if (adapted) RunAdapted(r, start, b, grid, filter, rts, &m[3], &m[4]);
     }
   } catch (const std::exception& e) {
-    filter.failure = rts.failure = batch.failure = e.what();
+    for (std::size_t i = failing_from; i < m.size(); ++i) m[i].failure = e.what();
   }
-  for (mc::MethodRecord* m : {&filter, &rts, &batch}) {
-    if (Wants(setup, m->method)) record.methods.push_back(std::move(*m));
+  for (mc::MethodRecord& method : m) {
+    if (Wants(setup, method.method)) record.methods.push_back(std::move(method));
   }
   return record;
 }

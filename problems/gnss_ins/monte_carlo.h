@@ -3,7 +3,9 @@
 //
 // A run simulates the scenario with its seed, writes the configuration a user of that
 // record would write (ConfigYamlForSimulation) and runs the filter, its RTS smoother and
-// the batch smoother (started from RTS) as `navtwin smooth` does. Quantities per method,
+// the batch smoother (started from RTS) as `navtwin smooth` does, then the filter and RTS
+// again with the noise the batch's variance components found ("filter_adapted",
+// "rts_adapted"; the plain ones when nothing changed). Quantities per method,
 // estimate - truth at whole seconds after the first IMU epoch (the method's knot at that
 // time, or its latest before it):
 //   position  NED, m;  velocity  NED, m/s;  attitude  Log(R_n_b_est R_n_b_true^T), NED, mrad;
@@ -22,10 +24,11 @@ namespace navtwin::gnss_ins {
 struct GnssInsMcSetup {
   std::string scenario;             ///< a preset name or a scenario YAML with GNSS
   std::string mag_mode = "vector";  ///< off, vector, heading, heading_2axis
-  std::vector<std::string> methods = {"filter", "rts", "batch"};
+  std::vector<std::string> methods = {"filter", "rts", "batch", "filter_adapted", "rts_adapted"};
 };
 
-/// Throws std::invalid_argument naming the bad method (filter, rts, batch) or mode.
+/// Throws std::invalid_argument naming the bad method (filter, rts, batch, filter_adapted,
+/// rts_adapted) or mode.
 void CheckGnssInsMcSetup(const GnssInsMcSetup& setup);
 
 /// Run `run` with `seed`. A failing estimator is recorded as failed, not passed on (the

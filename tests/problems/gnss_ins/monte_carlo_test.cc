@@ -52,10 +52,12 @@ const mc::Quantity& Find(const mc::MethodRecord& m, const std::string& name) {
 }
 
 TEST(GnssInsMcTest, ARunHasEveryMethodsErrorsAndPositiveDefiniteCovariances) {
+  // Every method, the adapted filter and RTS included (the batch's variance components
+  // rescale the noise on this record, so they are runs of their own).
   GnssInsMcSetup setup;
   setup.scenario = ScenarioFile();
   const mc::RunRecord r = GnssInsMcRun(setup, 7, 0);
-  ASSERT_EQ(r.methods.size(), 3u);
+  ASSERT_EQ(r.methods.size(), 5u);  // filter, rts, batch, filter_adapted, rts_adapted
   for (const mc::MethodRecord& m : r.methods) {
     ASSERT_TRUE(m.failure.empty()) << m.method << ": " << m.failure;
     for (const char* name : {"position", "velocity", "attitude"}) {
@@ -72,6 +74,8 @@ TEST(GnssInsMcTest, ARunHasEveryMethodsErrorsAndPositiveDefiniteCovariances) {
     const mc::Quantity& pos = Find(m, "position");
     EXPECT_LT(Eigen::Map<const Eigen::Vector3d>(&pos.error[59 * 3]).norm(), 5.0) << m.method;
   }
+  EXPECT_EQ(r.methods[3].method, "filter_adapted");
+  EXPECT_NE(Find(r.methods[3], "attitude").covariance, Find(r.methods[0], "attitude").covariance);
 }
 
 TEST(GnssInsMcTest, TheBoundLiesBelowTheFiltersSigmaInsideTheFlight) {
