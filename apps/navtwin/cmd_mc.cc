@@ -103,6 +103,7 @@ McProblem GnssInsProblem() {
   p.run = [=](std::uint64_t seed, int run) { return gnss_ins::GnssInsMcRun(setup, seed, run); };
   p.bound = [=]() { return gnss_ins::GnssInsBound(setup, FLAGS_seed); };
   p.notes.push_back("batch ANEES from its standard deviations only (no cross-covariances between position, velocity and attitude)");
+  p.notes.push_back("filter_adapted, rts_adapted: filter and RTS again with the noise the batch's variance components found");
   return p;
 }
 
