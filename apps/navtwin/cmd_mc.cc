@@ -199,7 +199,8 @@ int RunMc(const std::vector<std::string>& args) {
     std::cerr << "mc: " << runs << " runs of " << FLAGS_problem << " on " << problem.scenario << ", seed "
               << FLAGS_seed << (with_bound ? ", and the bound" : "") << "; "
               << session.ranks() << " rank" << (session.ranks() == 1 ? "" : "s") << " x "
-              << FLAGS_threads << " thread" << (FLAGS_threads == 1 ? "" : "s") << "\n";
+              << (FLAGS_threads == 0 ? "all cores" : std::to_string(FLAGS_threads) + (FLAGS_threads == 1 ? " thread" : " threads"))
+              << "\n";
   }
   // Item `runs` (the last) is the bound, so it is balanced like any run.
   const int items = runs + (with_bound ? 1 : 0);
@@ -207,9 +208,14 @@ int RunMc(const std::vector<std::string>& args) {
   mc::MethodRecord bound;
   const auto compute = [&](int item) {
     if (item == runs) {
+      // A bound that cannot be computed is reported, not the end of the runs.
       mc::RunRecord r;
       r.run = item;
-      r.methods.push_back(problem.bound());
+      try {
+        r.methods.push_back(problem.bound());
+      } catch (const std::exception& e) {
+        r.methods.push_back(mc::MethodRecord{"bound", e.what(), 0.0, {}});
+      }
       return mc::SerializeRunRecord(r);
     }
     return mc::SerializeRunRecord(problem.run(FLAGS_seed + static_cast<std::uint64_t>(item), item));
@@ -234,7 +240,11 @@ int RunMc(const std::vector<std::string>& args) {
                      ? "streams 0.." + std::to_string(runs - 1) + " of seed " + std::to_string(FLAGS_seed)
                      : "seeds " + std::to_string(FLAGS_seed) + ".." + std::to_string(FLAGS_seed + runs - 1);
   info.notes = problem.notes;
-  const mc::MethodRecord* bound_ptr = with_bound ? &bound : nullptr;
+  if (with_bound && !bound.failure.empty()) {
+    info.notes.push_back("no bound: " + bound.failure);
+    std::cerr << "mc: the bound failed: " << bound.failure << "\n";
+  }
+  const mc::MethodRecord* bound_ptr = with_bound && bound.failure.empty() ? &bound : nullptr;
   const std::vector<mc::MethodStatistics> stats = accumulator.Finish(bound_ptr);
   OutputFolder folder(FLAGS_out);
   folder.Make();
