@@ -13,8 +13,11 @@
 // Parameter blocks (the order every residual and every file uses):
 //   triad (12): s_x s_y s_z, M_xy M_xz M_yx M_yz M_zx M_zy, b_x b_y b_z
 //   g-sensitivity (9): G row-major
-// Templated on the scalar so that Ceres' Jets flow through; header-only and small.
+// Templated on the scalar so that Ceres' Jets flow through; small. The parameter names of
+// reports and files are in imu_error_model.cc.
 #pragma once
+
+#include <string>
 
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -95,5 +98,17 @@ Eigen::Matrix<T, 3, 1> CorrectedRate(const T* gyro, const T* g9, const Eigen::Ma
   if (g9 != nullptr) u -= GSensitivityMatrix(g9) * f;
   return TriadMatrix(gyro).inverse() * u;
 }
+
+/// "x", "y", "z" for axis 0, 1, 2.
+inline const char* AxisLetter(int axis) {
+  static const char* const kLetters[3] = {"x", "y", "z"};
+  return kLetters[axis];
+}
+
+/// Names of the parameters, in block order: "accel.scale_factor.x", "accel.misalignment.xy",
+/// "accel.bias.z" (triad = "accel" or "gyro"), "g_sensitivity.xy" (row x, col y). Throw
+/// std::out_of_range for an index outside the block.
+std::string TriadParameterName(const std::string& triad, int index);
+std::string GSensitivityParameterName(int index);
 
 }  // namespace navtwin

@@ -16,16 +16,6 @@
 namespace navtwin::calibration {
 namespace {
 
-const char* const kAxis[3] = {"x", "y", "z"};
-
-/// (row, col) of misalignment entry k = 0..5 of a triad block (index 3 + k).
-std::pair<int, int> MisalignmentRowCol(int k) {
-  const int row = k / 2;
-  const int j = k % 2;
-  const int col = j < row ? j : j + 1;  // inverse of MisalignmentIndex
-  return {row, col};
-}
-
 /// One row of a report: name, SI value and sigma, the factor to the printed unit and the unit.
 struct Row {
   std::string name;
@@ -98,7 +88,7 @@ std::vector<Row> TemperatureRows(const ImuCalibrationResult& result) {
     for (std::size_t k = 0; k < coefficients.size(); ++k) {
       for (int a = 0; a < 3; ++a) {
         Row r;
-        r.name = prefix + kAxis[a] + ".dT" + std::to_string(k + 1);
+        r.name = prefix + AxisLetter(a) + ".dT" + std::to_string(k + 1);
         r.value = coefficients[k](a);
         r.sigma = SigmaByName(result, r.name);
         r.per_si = per_si;
@@ -123,25 +113,6 @@ std::vector<Row> AllRows(const ImuCalibrationResult& result) {
 }
 
 }  // namespace
-
-std::string TriadParameterName(const std::string& triad, int index) {
-  if (index < 0 || index >= kTriadParameters) {
-    throw std::out_of_range("TriadParameterName: index " + std::to_string(index) + " not in [0, 12)");
-  }
-  if (index < 3) return triad + ".scale_factor." + kAxis[index];
-  if (index < 9) {
-    const auto [row, col] = MisalignmentRowCol(index - 3);
-    return triad + ".misalignment." + kAxis[row] + kAxis[col];
-  }
-  return triad + ".bias." + kAxis[index - 9];
-}
-
-std::string GSensitivityParameterName(int index) {
-  if (index < 0 || index >= kGSensitivityParameters) {
-    throw std::out_of_range("GSensitivityParameterName: index " + std::to_string(index) + " not in [0, 9)");
-  }
-  return std::string("g_sensitivity.") + kAxis[index / 3] + kAxis[index % 3];
-}
 
 std::vector<CalibrationResidual> StaticResiduals(const ImuCalibration& c, const std::vector<StaticPosition>& positions) {
   std::vector<CalibrationResidual> out;

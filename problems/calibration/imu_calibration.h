@@ -30,10 +30,7 @@
 
 namespace navtwin::calibration {
 
-/// Names of the parameters, in block order: "accel.scale_factor.x",
-/// "accel.misalignment.xy", "accel.bias.z", "gyro....", "g_sensitivity.xy" (row x, col y).
-std::string TriadParameterName(const std::string& triad, int index);
-std::string GSensitivityParameterName(int index);
+// Parameter names: TriadParameterName, GSensitivityParameterName (core/imu_error_model.h).
 
 /// A static position of a record (a table hold, a warm-up segment): the true and the mean
 /// measured specific force and rate in body axes.

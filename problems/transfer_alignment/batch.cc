@@ -36,6 +36,7 @@
 #include <ceres/problem.h>
 
 #include "core/earth.h"
+#include "core/imu_error_model.h"
 #include "core/imu_split.h"
 #include "core/rotation.h"
 #include "core/units.h"
@@ -44,7 +45,6 @@
 #include "factors/imu_preintegration.h"
 #include "factors/position_manifold.h"
 #include "factors/state_prior.h"
-#include "problems/calibration/imu_calibration.h"
 #include "problems/transfer_alignment/transfer_match.h"
 #include "problems/transfer_alignment/master.h"
 #include "solvers/batch_driver.h"
@@ -379,7 +379,7 @@ void TransferBatch::Covariance(TransferBatchSolution* out) {
       const double sigma = std::sqrt(std::max(0.0, P(row, row)));
       out->instrument_sigma[b.offset + k] = sigma;
       if (sigma > kNotObservableRatio * b.sigma) {
-        out->instrument_not_observable.push_back(calibration::TriadParameterName(b.triad, b.first_index + k));
+        out->instrument_not_observable.push_back(TriadParameterName(b.triad, b.first_index + k));
       }
     }
   }

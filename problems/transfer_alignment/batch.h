@@ -43,8 +43,9 @@ struct TransferBatchSolution {
   /// sigma of the instrument errors, in filter_model.h's istate layout (per triad: scale
   /// factors, misalignments; gyro, then accelerometer).
   Eigen::Matrix<double, kInstrumentStates, 1> instrument_sigma = Eigen::Matrix<double, kInstrumentStates, 1>::Zero();
-  /// The instrument errors the record does not determine: named as TriadParameterName
-  /// ("accel.scale_factor.x", ...) when their posterior sigma is above 0.9 of the prior's.
+  /// The instrument errors the record does not determine, named as TriadParameterName
+  /// (core/imu_error_model.h) gives them ("accel.scale_factor.x", ...): their posterior
+  /// sigma is above 0.9 of the prior's.
   std::vector<std::string> instrument_not_observable;
   std::vector<NavState> states;  ///< the smoothed slave states (attitude R_n_s)
   int iterations = 0;
