@@ -109,7 +109,7 @@ std::string BoundCsv(const Quantity& q) {
   const int d = q.dim();
   for (int p = 0; p < q.points(); ++p) {
     out << q.axis[p];
-    for (int i = 0; i < d; ++i) out << "," << std::sqrt(q.covariance[(p * d + i) * d + i]) * q.scale;
+    for (int i = 0; i < d; ++i) out << "," << q.Sigma(p, i) * q.scale;
     out << "\n";
   }
   return out.str();
@@ -210,7 +210,7 @@ std::string SummaryJson(const ExperimentInfo& info, const std::vector<MethodStat
     for (const Quantity& q : bound->quantities) {
       const int d = q.dim();
       std::vector<double> sigma;
-      for (int i = 0; i < d; ++i) sigma.push_back(std::sqrt(q.covariance[((q.points() - 1) * d + i) * d + i]));
+      for (int i = 0; i < d; ++i) sigma.push_back(q.Sigma(q.points() - 1, i));
       ComponentArray(w, q.name, sigma, q.scale);
     }
     w.EndObject();
@@ -290,7 +290,7 @@ std::string BoundTable(const MethodRecord& bound, bool json) {
     }
     for (const int p : shown) {
       std::vector<double> sigma;
-      for (int i = 0; i < d; ++i) sigma.push_back(std::sqrt(q.covariance[(p * d + i) * d + i]) * q.scale);
+      for (int i = 0; i < d; ++i) sigma.push_back(q.Sigma(p, i) * q.scale);
       if (json) {
         w.BeginObject().Field("at", q.axis[p]);
         ComponentArray(w, "sigma", sigma, 1.0);

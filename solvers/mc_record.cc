@@ -1,5 +1,6 @@
 #include "solvers/mc_record.h"
 
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
@@ -129,6 +130,14 @@ void Quantity::SetDiagonal(int point, const double* error_si, const double* sigm
   std::vector<double> cov(d * d, 0.0);
   for (int i = 0; i < d; ++i) cov[i * d + i] = sigma_si[i] * sigma_si[i];
   Set(point, error_si, cov.data());
+}
+
+std::vector<double> WholeSecondGrid(double t0_s, double t_end_s) {
+  std::vector<double> grid;
+  const int n = static_cast<int>(std::floor(t_end_s - t0_s + 1e-6));
+  for (int k = 1; k <= n; ++k) grid.push_back(t0_s + k);
+  if (grid.empty()) grid.push_back(t_end_s);
+  return grid;
 }
 
 std::string SerializeRunRecord(const RunRecord& record) {

@@ -8,6 +8,7 @@
 // covariances are the bound (its errors: those of the noise-free solution, near zero).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -28,6 +29,11 @@ struct Quantity {
 
   int dim() const { return static_cast<int>(components.size()); }
   int points() const { return static_cast<int>(axis.size()); }
+  /// sqrt of the covariance's diagonal entry (component i at point p), SI; NaN when unknown.
+  double Sigma(int point, int i) const {
+    const int d = dim();
+    return std::sqrt(covariance[(static_cast<std::size_t>(point) * d + i) * d + i]);
+  }
   /// A quantity with `points` axis points, every error and covariance NaN.
   static Quantity Empty(std::string name, std::string unit, double scale, std::string axis_name,
                         std::vector<std::string> components, std::vector<double> axis);
@@ -49,6 +55,10 @@ struct RunRecord {
   std::uint64_t seed = 0;
   std::vector<MethodRecord> methods;
 };
+
+/// The axis of a time series: t0 + 1, t0 + 2, ... up to t_end (whole seconds; a
+/// microsecond short of a whole second counts), or {t_end} when the span is under a second.
+std::vector<double> WholeSecondGrid(double t0_s, double t_end_s);
 
 /// Bytes of a record (host byte order: for ranks of one cluster) and back. Deserialize
 /// throws std::runtime_error for bytes that are not a whole record.

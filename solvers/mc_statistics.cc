@@ -60,9 +60,7 @@ void ApplyBound(const MethodRecord& bound, const std::string& name, double axis_
     const int d = q.dim();
     for (int p = 0; p < q.points(); ++p) {
       if (q.axis[p] != axis_value) continue;
-      for (int i = 0; i < d && i < static_cast<int>(s->bound_sigma.size()); ++i) {
-        s->bound_sigma[i] = std::sqrt(q.covariance[(p * d + i) * d + i]);
-      }
+      for (int i = 0; i < d && i < static_cast<int>(s->bound_sigma.size()); ++i) s->bound_sigma[i] = q.Sigma(p, i);
       return;
     }
   }
@@ -122,7 +120,7 @@ void Accumulator::AddQuantity(const Quantity& q, int runs_before, MethodSums* m)
   const int last = q.points() - 1;
   for (int i = 0; i < d; ++i) {
     sums->final_error.push_back(last >= 0 ? q.error[last * d + i] : kNaN);
-    sums->final_sigma.push_back(last >= 0 ? std::sqrt(q.covariance[(last * d + i) * d + i]) : kNaN);
+    sums->final_sigma.push_back(last >= 0 ? q.Sigma(last, i) : kNaN);
   }
 }
 

@@ -76,12 +76,17 @@ std::vector<Method> MethodsFromFlag(const std::vector<Method>& all, Parse parse)
   return out;
 }
 
+/// The problem's configuration from --config, or its defaults.
+template <typename Config>
+std::shared_ptr<const Config> ConfigFromFlag(Config (*load)(const std::string&)) {
+  return std::make_shared<const Config>(FLAGS_config.empty() ? Config() : load(FLAGS_config));
+}
+
 McProblem TransferProblem() {
   McProblem p;
   p.scenario = FLAGS_scenario.empty() ? "transfer-alignment-high-maneuver" : FLAGS_scenario;
-  const auto scenario = std::make_shared<sim::Scenario>(sim::LoadScenario(p.scenario));
-  const auto config = std::make_shared<transfer::TransferConfig>(
-      FLAGS_config.empty() ? transfer::TransferConfig() : transfer::LoadTransferConfig(FLAGS_config));
+  const auto scenario = std::make_shared<const sim::Scenario>(sim::LoadScenario(p.scenario));
+  const auto config = ConfigFromFlag(&transfer::LoadTransferConfig);
   using transfer::Method;
   const std::vector<Method> methods = MethodsFromFlag<Method>(
       {Method::kOrder1, Method::kOrder2, Method::kHistory, Method::kBatch}, &transfer::ParseMethod);
@@ -110,9 +115,8 @@ McProblem GnssInsProblem() {
 McProblem InflightProblem() {
   McProblem p;
   p.scenario = FLAGS_scenario.empty() ? "inflight-mach07-south" : FLAGS_scenario;
-  const auto scenario = std::make_shared<sim::Scenario>(sim::LoadScenario(p.scenario));
-  const auto config = std::make_shared<inflight::InflightConfig>(
-      FLAGS_config.empty() ? inflight::InflightConfig() : inflight::LoadInflightConfig(FLAGS_config));
+  const auto scenario = std::make_shared<const sim::Scenario>(sim::LoadScenario(p.scenario));
+  const auto config = ConfigFromFlag(&inflight::LoadInflightConfig);
   using inflight::Method;
   const std::vector<Method> methods =
       MethodsFromFlag<Method>({Method::kDistance, Method::kKalman, Method::kBatch}, &inflight::ParseMethod);

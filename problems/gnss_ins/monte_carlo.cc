@@ -15,6 +15,7 @@
 #include "core/rotation.h"
 #include "core/sim/scenario.h"
 #include "core/sim/simulator.h"
+#include "core/units.h"
 #include "problems/gnss_ins/adapted_noise.h"
 #include "problems/gnss_ins/batch.h"
 #include "problems/gnss_ins/config.h"
@@ -29,7 +30,7 @@ namespace navtwin::gnss_ins {
 
 namespace {
 
-constexpr double kMradPerRad = 1000.0;
+constexpr double kMradPerRad = 1.0 / kMrad_rad;  // display scale
 constexpr double kKnotMatch_s = 1e-6;
 const std::vector<std::string> kMethods = {"filter", "rts", "batch", "filter_adapted", "rts_adapted"};
 
@@ -64,11 +65,7 @@ McRecord SimulateMcRecord(const GnssInsMcSetup& setup, std::uint64_t seed, bool 
 }
 
 std::vector<double> McGrid(const Inputs& inputs) {
-  const double t0 = inputs.imu.begin_s();
-  const double span = inputs.imu.known_end_s() - t0;
-  std::vector<double> grid;
-  for (int k = 1; k <= static_cast<int>(std::floor(span + kKnotMatch_s)); ++k) grid.push_back(t0 + k);
-  return grid;
+  return mc::WholeSecondGrid(inputs.imu.begin_s(), inputs.imu.known_end_s());
 }
 
 struct NavQuantities {
@@ -93,13 +90,11 @@ std::vector<mc::Quantity> QuantitiesOf(const Solution& s, const std::vector<Eige
     const std::optional<NavState> t = NavAt(truth, knot.state.nav.t_s);
     if (!t || knot.std.size() < ins::err::kBa + 3) continue;
     const NavError e = CompareNav(knot.state.nav, *t);
-    const Eigen::Vector3d e_att =
-        LogSO3(Eigen::Matrix3d((knot.state.nav.q_n_b * t->q_n_b.conjugate()).toRotationMatrix()));
-    Eigen::MatrixXd P = knot.std.array().square().matrix().asDiagonal();
-    if (covariances != nullptr && k - 1 < covariances->size()) P = (*covariances)[k - 1];
-    const auto block = [&](int at) {
-      Eigen::Matrix<double, 3, 3, Eigen::RowMajor> b = P.block<3, 3>(at, at);
-      return b;
+    const Eigen::Vector3d e_att = AttitudeError(knot.state.nav.q_n_b, t->q_n_b);  // Log(R_n_b_est R_n_b_true^T)
+    const bool full = covariances != nullptr && k - 1 < covariances->size();
+    const auto block = [&](int at) -> Eigen::Matrix<double, 3, 3, Eigen::RowMajor> {
+      if (full) return (*covariances)[k - 1].block<3, 3>(at, at);
+      return knot.std.segment<3>(at).array().square().matrix().asDiagonal();
     };
     const auto pos = block(ins::err::kPos), vel = block(ins::err::kVel), att = block(ins::err::kAtt);
     q.position.Set(p, e.pos_ned_m.data(), pos.data());

@@ -14,27 +14,19 @@ namespace navtwin::transfer {
 
 namespace {
 
-constexpr double kMsPerS = 1000.0;
-constexpr double kMradPerRad = 1000.0;
+constexpr double kMsPerS = 1.0 / kMillisecond_s;  // display scales
+constexpr double kMradPerRad = 1.0 / kMrad_rad;
 
 /// Whole seconds after the slave's start up to its last IMU sample.
 std::vector<double> McGrid(const TransferInputs& in) {
-  const double t0 = in.slave_initial.t_s;
-  const double span = in.slave_imu.back().t_s - t0;
-  std::vector<double> grid;
-  for (int k = 1; k <= static_cast<int>(std::floor(span)); ++k) grid.push_back(t0 + k);
-  if (grid.empty()) grid.push_back(in.slave_imu.back().t_s);
-  return grid;
+  return mc::WholeSecondGrid(in.slave_initial.t_s, in.slave_imu.back().t_s);
 }
 
-Eigen::Quaterniond FromEulerDeg(const Eigen::Vector3d& rpy_deg) {
-  const Eigen::Vector3d r = rpy_deg * kDegToRad;
-  return Eigen::Quaterniond(DcmFromEuler(r.x(), r.y(), r.z())).normalized();
-}
-
-/// Log(M_est M_true^T): the misalignment error as a rotation vector (rad).
-Eigen::Vector3d MisalignmentError(const Eigen::Quaterniond& est, const Eigen::Quaterniond& truth) {
-  return LogSO3(Eigen::Matrix3d((est * truth.conjugate()).toRotationMatrix()));
+/// Log(M_est M_true^T), M = R_b_s from ZYX Euler angles in degrees: the misalignment error
+/// as a rotation vector in the master body axes (rad), estimate minus truth.
+Eigen::Vector3d MisalignmentError(const Eigen::Vector3d& rpy_est_deg, const Eigen::Quaterniond& M_true) {
+  const Eigen::Vector3d r = rpy_est_deg * kDegToRad;
+  return AttitudeError(QuatFromEuler(r.x(), r.y(), r.z()), M_true);
 }
 
 mc::Quantity MisalignmentQuantity(const std::vector<double>& grid) {
@@ -51,7 +43,7 @@ mc::Quantity JointQuantity(double t_final) {
 void SetFinalJoint(const TransferResult& r, const TransferInputs& in, mc::Quantity* joint, mc::Quantity* mis,
                    mc::Quantity* delay) {
   Eigen::Vector4d e;
-  e.head<3>() = MisalignmentError(FromEulerDeg(r.misalignment_deg), *in.true_misalignment);
+  e.head<3>() = MisalignmentError(r.misalignment_deg, *in.true_misalignment);
   e(3) = r.delay_s - *in.true_delay_s;
   const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> P = r.misalignment_delay_covariance;
   joint->Set(0, e.data(), P.data());
@@ -72,7 +64,7 @@ std::vector<mc::Quantity> QuantitiesOf(const TransferResult& r, const TransferIn
     while (k < r.estimates.size() && r.estimates[k].t_s <= grid[p]) ++k;
     if (k > 0) {
       const TransferResult::Estimate& est = r.estimates[k - 1];
-      const Eigen::Vector3d e = MisalignmentError(FromEulerDeg(est.misalignment_deg), *in.true_misalignment);
+      const Eigen::Vector3d e = MisalignmentError(est.misalignment_deg, *in.true_misalignment);
       const Eigen::Vector3d sigma = est.misalignment_sigma_mrad / kMradPerRad;
       mis.SetDiagonal(p, e.data(), sigma.data());
       const double e_tau = est.delay_s - *in.true_delay_s;
