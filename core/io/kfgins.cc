@@ -336,12 +336,16 @@ void KfginsGnssWriter::Commit() { file_.Commit(); }
 
 KfginsNavWriter::KfginsNavWriter(const std::string& path) : file_(path) {}
 
-void AppendNavFields(const NavState& s, char separator, TextLine* line) {
+void RequireWritableNavState(const NavState& s) {
   RequireFinite(s.t_s, "navigation time");
   RequireFinite(Eigen::Vector3d(s.lat_rad, s.lon_rad, s.h_m), "navigation position");
   RequireFinite(s.v_n_mps, "navigation velocity");
   RequireFinite(s.q_n_b.coeffs().head<3>(), "attitude quaternion");
   RequirePossible(s);
+}
+
+void AppendNavFields(const NavState& s, char separator, TextLine* line) {
+  RequireWritableNavState(s);
   // Longitude in (-180, 180]: the estimators do not all wrap it (a state past the
   // antimeridian is possible, its longitude written as the format has it).
   const double lon_rad = std::abs(s.lon_rad) > kPi ? WrapPi(s.lon_rad) : s.lon_rad;

@@ -68,6 +68,10 @@ class KfginsGnssWriter {
 /// 90 deg, a height or a velocity outside the limits of core/io/plausibility.h.
 void AppendNavFields(const NavState& s, char separator, TextLine* line);
 
+/// Throws the std::invalid_argument AppendNavFields would throw for `s`, if any (a writer
+/// that formats later, on another thread, refuses a state when it is handed over).
+void RequireWritableNavState(const NavState& s);
+
 /// Writes the navigation format; gps_week = -1 (unknown) is written as week 0. Attitude
 /// as ZYX Euler angles (roll, pitch, yaw) of q_n_b in degrees.
 class KfginsNavWriter {

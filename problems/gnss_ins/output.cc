@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,10 +11,23 @@
 #include <stdexcept>
 
 #include "core/io/text_line.h"
+#include "core/io/write_queue.h"
 #include "core/rotation.h"
 #include "core/units.h"
 
 namespace navtwin::gnss_ins {
+
+/// What a row of the output files needs from an epoch, copied when the epoch is handed to
+/// the writer thread (core/io/write_queue.h). std_size: entries of NavEpoch::std (0 when
+/// the estimator computed none).
+struct OutputRow {
+  NavState nav;
+  ImuErrors imu;
+  double std[err::kSize21];
+  int std_size;
+  bool with_std;
+};
+
 namespace {
 
 /// One CSV row, numbers in the shortest form that reads back exactly (TextLine: the
@@ -53,8 +67,17 @@ void WriteNavCsvRow(std::ostream& out, const NavState& s) {
   line.Char('\n').WriteTo(out);
 }
 
+OutputRow MakeOutputRow(const NavEpoch& epoch, bool with_std) {
+  RequireWritableNavState(epoch.state.nav);  // refused now, not later on the writer thread
+  OutputRow row{epoch.state.nav, epoch.state.imu, {}, 0, with_std};
+  if (!with_std) return row;
+  row.std_size = static_cast<int>(std::min<Eigen::Index>(epoch.std.size(), err::kSize21));
+  for (int i = 0; i < row.std_size; ++i) row.std[i] = epoch.std[i];
+  return row;
+}
+
 /// Standard deviations in the units of the header; NaN where not computed.
-void WriteStdCsvRow(std::ostream& out, const NavEpoch& epoch, bool scale_factors) {
+void WriteStdCsvRow(std::ostream& out, const OutputRow& row, bool scale_factors) {
   const int n = scale_factors ? err::kSize21 : err::kSize15;
   double sd[err::kSize21];
   for (int i = 0; i < n; ++i) {
@@ -63,9 +86,22 @@ void WriteStdCsvRow(std::ostream& out, const NavEpoch& epoch, bool scale_factors
     if (i >= err::kBg && i < err::kBa) scale = 1.0 / kDegPerHour_radps;
     if (i >= err::kBa && i < err::kSg) scale = 1.0 / kMilliG_mps2;
     if (i >= err::kSg) scale = 1.0 / kPpm;
-    sd[i] = i < epoch.std.size() ? epoch.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
+    sd[i] = i < row.std_size ? row.std[i] * scale : std::numeric_limits<double>::quiet_NaN();
   }
-  Row(out, epoch.state.nav.t_s, sd, n);
+  Row(out, row.nav.t_s, sd, n);
+}
+
+/// imu_errors.csv's row in the units of its header.
+void WriteImuErrorsRow(std::ostream& out, const OutputRow& row, bool scale_factors) {
+  const ImuErrors& e = row.imu;
+  double imu[12];
+  for (int i = 0; i < 3; ++i) {
+    imu[i] = e.bg_radps[i] / kDegPerHour_radps;
+    imu[3 + i] = e.ba_mps2[i] / kMilliG_mps2;
+    imu[6 + i] = e.sg[i] / kPpm;
+    imu[9 + i] = e.sa[i] / kPpm;
+  }
+  Row(out, row.nav.t_s, imu, scale_factors ? 12 : 6);
 }
 
 /// `to` as a hard link of `from` (replacing a file of that name), or a copy where the file
@@ -107,7 +143,8 @@ NavOutputWriter::NavOutputWriter(const std::string& dir, bool scale_factors)
       nav_(dir + "/" + kFiles[0]),
       csv_(dir + "/" + kFiles[1]),
       std_(dir + "/" + kFiles[2]),
-      errors_(dir + "/" + kFiles[3]) {
+      errors_(dir + "/" + kFiles[3]),
+      rows_(std::make_unique<Rows>(this)) {
   WriteNavCsvHeader(csv_.stream());
   WriteStdCsvHeader(std_.stream(), scale_factors_);
   errors_.stream() << "t_s,bg_x_deg_h,bg_y_deg_h,bg_z_deg_h,ba_x_mg,ba_y_mg,ba_z_mg";
@@ -115,28 +152,33 @@ NavOutputWriter::NavOutputWriter(const std::string& dir, bool scale_factors)
   errors_.stream() << '\n';
 }
 
-void NavOutputWriter::Write(const NavEpoch& epoch, bool with_std) {
-  const NavState& s = epoch.state.nav;
-  TextLine fields;  // nav.csv's row, and nav.nav's record after the week: formatted once
-  AppendNavFields(s, ',', &fields);  // checks the state is finite (std::invalid_argument otherwise)
-  nav_.WriteFields(s.gps_week, fields.view());
-  fields.Char('\n').WriteTo(csv_.stream());
-  ++count_;
-  if (!with_std) return;
-  WriteStdCsvRow(std_.stream(), epoch, scale_factors_);
-
-  const ImuErrors& e = epoch.state.imu;
-  double imu[12];
-  for (int i = 0; i < 3; ++i) {
-    imu[i] = e.bg_radps[i] / kDegPerHour_radps;
-    imu[3 + i] = e.ba_mps2[i] / kMilliG_mps2;
-    imu[6 + i] = e.sg[i] / kPpm;
-    imu[9 + i] = e.sa[i] / kPpm;
+/// The rows on their way to the four files, formatted on the queue's writer thread.
+struct NavOutputWriter::Rows {
+  explicit Rows(NavOutputWriter* w)
+      : queue([w](const std::vector<OutputRow>& rows) { Write(*w, rows); }) {}
+  static void Write(NavOutputWriter& w, const std::vector<OutputRow>& rows) {
+    for (const OutputRow& row : rows) {
+      TextLine fields;  // nav.csv's row, and nav.nav's record after the week: formatted once
+      AppendNavFields(row.nav, ',', &fields);
+      w.nav_.WriteFields(row.nav.gps_week, fields.view());
+      fields.Char('\n').WriteTo(w.csv_.stream());
+      if (!row.with_std) continue;
+      WriteStdCsvRow(w.std_.stream(), row, w.scale_factors_);
+      WriteImuErrorsRow(w.errors_.stream(), row, w.scale_factors_);
+    }
   }
-  Row(errors_.stream(), s.t_s, imu, scale_factors_ ? 12 : 6);
+  WriteQueue<OutputRow> queue;
+};
+
+NavOutputWriter::~NavOutputWriter() { rows_.reset(); }  // the writer thread ends before the files go
+
+void NavOutputWriter::Write(const NavEpoch& epoch, bool with_std) {
+  rows_->queue.Push(MakeOutputRow(epoch, with_std));
+  ++count_;
 }
 
 void NavOutputWriter::Commit() {
+  rows_->queue.Finish();
   nav_.Commit();
   csv_.Commit();
   std_.Commit();
@@ -163,9 +205,11 @@ MethodOutputWriter::MethodOutputWriter(const std::string& out_dir, const std::st
   }
   WriteNavCsvHeader(nav_csv_->stream());
   WriteStdCsvHeader(std_csv_->stream(), scale_factors_);
+  rows_ = std::make_unique<Rows>(this);
 }
 
 MethodOutputWriter::~MethodOutputWriter() {
+  rows_.reset();  // the writer thread ends before the files go
   nav_csv_.reset();  // each removes its temporary unless committed
   std_csv_.reset();
   errors_csv_.reset();
@@ -181,15 +225,28 @@ std::vector<AtomicFile*> MethodOutputWriter::Files() const {
   return files;
 }
 
+/// The rows on their way to nav.csv and std.csv, formatted on the queue's writer thread.
+struct MethodOutputWriter::Rows {
+  explicit Rows(MethodOutputWriter* w)
+      : queue([w](const std::vector<OutputRow>& rows) { Write(*w, rows); }) {}
+  static void Write(MethodOutputWriter& w, const std::vector<OutputRow>& rows) {
+    for (const OutputRow& row : rows) {
+      WriteNavCsvRow(w.nav_csv_->stream(), row.nav);
+      if (row.with_std) WriteStdCsvRow(w.std_csv_->stream(), row, w.scale_factors_);
+    }
+  }
+  WriteQueue<OutputRow> queue;
+};
+
 void MethodOutputWriter::Write(const NavEpoch& epoch, bool with_std) {
   if (shares_top_level_) throw std::logic_error("MethodOutputWriter: Write on a method sharing the top-level files");
-  WriteNavCsvRow(nav_csv_->stream(), epoch.state.nav);
-  if (with_std) WriteStdCsvRow(std_csv_->stream(), epoch, scale_factors_);
+  rows_->queue.Push(MakeOutputRow(epoch, with_std));
   ++count_;
 }
 
 void MethodOutputWriter::ShareTopLevelFiles() {
   shares_top_level_ = true;
+  rows_.reset();
   nav_csv_.reset();  // removes the temporaries
   std_csv_.reset();
 }
@@ -236,6 +293,7 @@ void MethodOutputWriter::WriteResiduals(const std::vector<MeasurementResidual>& 
 }
 
 void MethodOutputWriter::Commit() {
+  if (rows_) rows_->queue.Finish();
   for (AtomicFile* f : Files()) f->Commit();
   committed_ = true;
   if (!shares_top_level_) return;

@@ -60,10 +60,15 @@ class NavOutputWriter {
  public:
   /// `dir` must exist. Throws std::runtime_error when a file cannot be opened.
   NavOutputWriter(const std::string& dir, bool scale_factors);
+  ~NavOutputWriter();
+  NavOutputWriter(const NavOutputWriter&) = delete;
+  NavOutputWriter& operator=(const NavOutputWriter&) = delete;
   /// Appends one epoch (in time order) to nav.nav and nav.csv and, with `with_std`, to
-  /// std.csv and imu_errors.csv.
+  /// std.csv and imu_errors.csv. The state is checked here (std::invalid_argument for one
+  /// AppendNavFields refuses); the rows are formatted and written on a writer thread
+  /// (core/io/write_queue.h), so the caller does not wait for the disk.
   void Write(const NavEpoch& epoch, bool with_std);
-  /// Renames the four files into place.
+  /// Waits for the rows written, then renames the four files into place.
   void Commit();
   /// Undoes a Commit (a later step of the run failed): removes the four files.
   void Revoke();
@@ -79,6 +84,8 @@ class NavOutputWriter {
   AtomicFile csv_;
   AtomicFile std_;
   AtomicFile errors_;
+  struct Rows;
+  std::unique_ptr<Rows> rows_;  ///< the writer thread's queue; last, so it ends first
 };
 
 /// The folder <out_dir>/<method>/ (layout above). The folder is created when missing and,
@@ -92,7 +99,8 @@ class MethodOutputWriter {
   MethodOutputWriter(const MethodOutputWriter&) = delete;
   MethodOutputWriter& operator=(const MethodOutputWriter&) = delete;
 
-  /// Appends one output epoch (in time order) to nav.csv and, with `with_std`, std.csv.
+  /// Appends one output epoch (in time order) to nav.csv and, with `with_std`, std.csv;
+  /// checked and handed to a writer thread as NavOutputWriter::Write does.
   void Write(const NavEpoch& epoch, bool with_std);
   /// The method is the run's output method: its nav.csv and std.csv are the top level's
   /// (<out_dir>/nav.csv, std.csv), which Commit() hard-links (copies where the file system
@@ -124,6 +132,8 @@ class MethodOutputWriter {
   std::size_t count_ = 0;
   std::unique_ptr<AtomicFile> nav_csv_, std_csv_;
   std::unique_ptr<AtomicFile> errors_csv_, residuals_csv_;  ///< null until opened
+  struct Rows;
+  std::unique_ptr<Rows> rows_;  ///< nav.csv's and std.csv's writer thread (null when shared)
   /// The files opened, in the order above.
   std::vector<AtomicFile*> Files() const;
 };

@@ -143,12 +143,51 @@ TEST(NavOutputWriter, ScaleFactorColumnsAndMissingStd) {
   EXPECT_NEAR(e[10], 100.0, kTol);  // sa_x
 }
 
+// Rows cross the writer thread in batches: 5,000 epochs (more than two batches), σ every
+// 200th, come out in order and byte for byte as the one-record writer formats them.
+TEST(NavOutputWriter, ManyEpochsComeOutInOrderAsTheRecordWriterFormatsThem) {
+  const std::string dir = MakeTempDir();
+  const std::string reference = dir + "/reference.nav";
+  {
+    NavOutputWriter w(dir, false);
+    KfginsNavWriter one_by_one(reference);
+    for (int k = 0; k < 5000; ++k) {
+      NavEpoch e = Epoch(100.0 + 0.005 * k, 15);
+      e.state.nav.lat_rad += 1e-9 * k;
+      e.state.nav.h_m += 0.001 * k;
+      w.Write(e, k % 200 == 0);
+      one_by_one.Write(e.state.nav);
+    }
+    w.Commit();
+    one_by_one.Commit();
+  }
+  const auto nav = Lines(dir + "/nav.nav");
+  const auto expected = Lines(reference);
+  ASSERT_EQ(nav.size(), 5000u);
+  EXPECT_EQ(nav, expected);
+  const auto csv = Lines(dir + "/nav.csv");
+  ASSERT_EQ(csv.size(), 5001u);
+  for (std::size_t k = 0; k < 5000; ++k) {
+    std::string as_csv = expected[k].substr(expected[k].find(' ') + 1);  // without the week
+    for (char& c : as_csv) c = c == ' ' ? ',' : c;
+    ASSERT_EQ(csv[k + 1], as_csv) << "row " << k;
+  }
+  const auto sd = Lines(dir + "/std.csv");
+  ASSERT_EQ(sd.size(), 26u);  // header + 25
+  EXPECT_EQ(Numbers(sd[25])[0], 100.0 + 0.005 * 4800);
+  EXPECT_EQ(Lines(dir + "/imu_errors.csv").size(), 26u);
+}
+
 // A run that fails (the writer destroyed before Commit) leaves no file behind.
 TEST(NavOutputWriter, NothingAppearsWithoutCommit) {
   const std::string dir = MakeTempDir();
   {
     NavOutputWriter w(dir, false);
     w.Write(Epoch(1.0, 15), true);
+  }
+  {
+    NavOutputWriter w(dir, false);  // batches already on the writer thread when it fails
+    for (int k = 0; k < 5000; ++k) w.Write(Epoch(1.0 + 0.005 * k, 15), true);
   }
   EXPECT_EQ(::rmdir(dir.c_str()), 0) << "the folder should be empty";
 }
