@@ -29,7 +29,7 @@ class WriteQueue {
   using Batch = std::vector<Row>;
   using Sink = std::function<void(const Batch&)>;
 
-  explicit WriteQueue(Sink sink, std::size_t batch_rows = 2048, std::size_t depth = 4)
+  explicit WriteQueue(Sink sink, std::size_t batch_rows = 256, std::size_t depth = 4)
       : sink_(std::move(sink)), batch_rows_(batch_rows < 1 ? 1 : batch_rows), depth_(depth < 1 ? 1 : depth) {
     filling_.reserve(batch_rows_);
   }
@@ -52,7 +52,7 @@ class WriteQueue {
     finished_ = true;
     if (!worker_.joinable()) {
       if (!filling_.empty()) sink_(filling_);
-      filling_.clear();
+      Batch().swap(filling_);
       return;
     }
     if (!filling_.empty()) Hand();
@@ -62,6 +62,8 @@ class WriteQueue {
     }
     ready_.notify_one();
     worker_.join();
+    spare_.clear();  // the queue's memory goes now, not when its owner does
+    Batch().swap(filling_);
     if (error_) std::rethrow_exception(error_);
   }
 
