@@ -241,6 +241,7 @@ class BatchSmoother : public ins::BatchAccess {
   /// The IMU samples (and the piece of the one holding t0) in the kMaxSensorAssociation_s
   /// before the first state: with the preintegrated pieces, the increments BodyRotation needs.
   std::vector<ImuSample> before_start_;
+  bool keep_pieces_ = false;     ///< a source calls BodyRotation: the pieces are stored
   bool pieces_dropped_ = false;  ///< after BuildProblem: BodyRotation no longer available
   std::vector<ceres::ResidualBlockId> imu_factors_;
   std::map<std::string, MeasurementCount> counts_;
@@ -381,6 +382,8 @@ void BatchSmoother::MechanizeAndPreintegrate() {
   std::size_t kn = 1, si = 0;
   Eigen::Vector3d omega = Eigen::Vector3d::Zero();
   const ins::StillnessConfig* still_rule = ins::StillnessRule(sources_);
+  keep_pieces_ = std::any_of(sources_.begin(), sources_.end(),
+                             [](const auto& source) { return source->rotates_samples_to_states(); });
   std::optional<ins::StillnessDetector> detector;
   if (still_rule != nullptr) detector.emplace(*still_rule);
   ins::MotionWindow motion(noise.gyro_arw_rad_per_sqrt_s, noise.accel_vrw_mps_per_sqrt_s);
@@ -408,6 +411,9 @@ void BatchSmoother::MechanizeAndPreintegrate() {
     if (si + 1 < n) {
       pre_[si] = std::make_shared<ImuPreintegration>(ErrorsOf(s), noise.gyro_arw_rad_per_sqrt_s,
                                                      noise.accel_vrw_mps_per_sqrt_s);
+      // Without a source that rotates samples to states nothing reads the pieces: none
+      // are stored (tens of MB for an hour, and the holes they leave in the heap).
+      if (!keep_pieces_) pre_[si]->DropSamples();
     }
     ++si;
   };
@@ -651,6 +657,9 @@ void BatchSmoother::AddAuxPriors() {
 /// samples before the first state).
 Eigen::Quaterniond BatchSmoother::BodyRotation(double a_s, double b_s, const ImuErrors& errors) const {
   if (pieces_dropped_) throw std::logic_error("BatchSmoother::BodyRotation: called after the problem was built");
+  if (!keep_pieces_) {
+    throw std::logic_error("BatchSmoother::BodyRotation: no source declared rotates_samples_to_states()");
+  }
   std::vector<ImuSample> pieces;
   if (a_s < states_.front().t_s) pieces = before_start_;
   const auto first = std::upper_bound(states_.begin(), states_.end(), a_s,

@@ -151,6 +151,9 @@ class AidingSource {
   virtual const std::vector<double>& times() const = 0;
   /// Whether the batch places a state at each sample time (at most one source does).
   virtual bool anchors_batch_states() const { return false; }
+  /// Whether AddToBatch calls BatchAccess::BodyRotation: the batch keeps the IMU pieces
+  /// of every interval until the problem is built only when a source says so.
+  virtual bool rotates_samples_to_states() const { return false; }
   /// The stillness rule this source decides with (null: none).
   virtual const StillnessConfig* stillness_rule() const { return nullptr; }
   virtual std::vector<AuxState> aux_states() const { return {}; }

@@ -44,6 +44,7 @@ class MagSource : public AidingSource {
   std::vector<std::string> keys() const override { return {kMag}; }
   Timing timing() const override { return Timing::kNextEpoch; }
   const std::vector<double>& times() const override { return times_; }
+  bool rotates_samples_to_states() const override { return config_.mode != MagConfig::Mode::kOff && !samples_.empty(); }
 
   void FilterUpdate(std::size_t k, FilterAccess& filter) override {
     const MagSample& sample = samples_[k];
