@@ -38,13 +38,14 @@ using ins::StateBlock;
 class NavigationFilter : public ins::FilterAccess {
  public:
   NavigationFilter(const Inputs& inputs, const GnssInsConfig& config, const FilterStart& start, bool run_rts,
-                   bool keep_covariances, const std::function<void(const NavEpoch&)>& output,
+                   FilterKnots knots, const std::function<void(const NavEpoch&)>& output,
                    std::ostream* progress)
       : in_(inputs),
         cfg_(config),
         n_ins_(config.filter.scale_factors ? err::kSize21 : err::kSize15),
         run_rts_(run_rts),
-        keep_covariances_(keep_covariances),
+        keep_covariances_(knots == FilterKnots::kAllWithCovariances),
+        keep_last_only_(knots == FilterKnots::kLast),
         output_(output),
         progress_(progress),
         start_(start),
@@ -169,7 +170,12 @@ class NavigationFilter : public ins::FilterAccess {
   void StoreKnot(double t_s, bool after_updates) {
     NavEpoch e = Epoch(Nominal(), aux_, P_);
     e.state.nav.t_s = t_s;
-    epochs_.push_back(std::move(e));
+    if (keep_last_only_ && !epochs_.empty()) {
+      epochs_.back() = std::move(e);
+      ++knots_not_kept_;
+    } else {
+      epochs_.push_back(std::move(e));
+    }
     if (keep_covariances_) filter_covariances_.push_back(P_);
     if (run_rts_) {
       RtsKnot k;
@@ -270,6 +276,8 @@ class NavigationFilter : public ins::FilterAccess {
   int n_ = 0;        ///< n_ins_ plus the sources' auxiliary states
   const bool run_rts_;
   const bool keep_covariances_;
+  const bool keep_last_only_;       ///< FilterKnots::kLast: epochs_ holds the newest knot
+  std::size_t knots_not_kept_ = 0;
   const std::function<void(const NavEpoch&)>& output_;
   std::ostream* progress_;
   const FilterStart start_;
@@ -493,6 +501,7 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
   FilterResult result;
   result.filter.method = "filter";
   result.filter.epochs = std::move(epochs_);
+  result.filter.knots_not_kept = knots_not_kept_;
   result.filter.counts = counts_;
   result.filter.aux_states = aux_states_;
   result.filter.measurement_residuals = std::move(measurement_residuals_);
@@ -533,16 +542,19 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
 
 FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, const FilterStart& start, bool run_rts,
                        const std::function<void(const NavEpoch&)>& output, std::ostream* progress,
-                       bool keep_covariances) {
-  NavigationFilter filter(inputs, config, start, run_rts, keep_covariances, output, progress);
+                       FilterKnots knots) {
+  if (knots == FilterKnots::kLast && run_rts) {
+    throw std::invalid_argument("RunFilter: the RTS smoother needs every knot (FilterKnots::kLast with run_rts)");
+  }
+  NavigationFilter filter(inputs, config, start, run_rts, knots, output, progress);
   return filter.Run();
 }
 
 FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, bool run_rts,
                        const std::function<void(const NavEpoch&)>& output, std::ostream* progress,
-                       bool keep_covariances) {
+                       FilterKnots knots) {
   const FilterStart start = InitialFilterState(inputs, config, progress);
-  return RunFilter(inputs, config, start, run_rts, output, progress, keep_covariances);
+  return RunFilter(inputs, config, start, run_rts, output, progress, knots);
 }
 
 }  // namespace navtwin::gnss_ins

@@ -66,12 +66,21 @@ struct FilterResult {
   /// computes the NEES from the covariances below.
   double nees_mean = std::numeric_limits<double>::quiet_NaN();
   /// Full error-state covariances (n x n, ins_state.h layout), one per knot in the order of
-  /// filter.epochs (P_post) and rts->epochs (smoothed); filled only when RunFilter is asked
-  /// to keep them (consistency checks).
+  /// filter.epochs (P_post) and rts->epochs (smoothed); filled only with
+  /// FilterKnots::kAllWithCovariances (consistency checks).
   std::vector<Eigen::MatrixXd> filter_covariances;
   std::vector<Eigen::MatrixXd> rts_covariances;
   /// Per measurement kind (the keys of Solution::counts).
   std::map<std::string, InnovationStats> innovations;
+};
+
+/// What RunFilter keeps of its knots.
+enum class FilterKnots {
+  kAll,                 ///< every knot in filter.epochs (the RTS smoother needs them)
+  kAllWithCovariances,  ///< and their full covariances (filter_covariances, rts_covariances)
+  /// Only the last knot (filter.epochs holds one, Solution::knots_not_kept counts the
+  /// others): memory independent of the record's length. Not with run_rts.
+  kLast,
 };
 
 /// Runs the error-state filter over the inputs (and the RTS smoother when run_rts).
@@ -81,6 +90,8 @@ struct FilterResult {
 /// between calls (copy what you keep). Its std comes from the covariance at the end of
 /// the last covariance group (at most covariance_interval_s old).
 /// Progress (about every 5 % of the record) on `progress` if not null.
+/// `knots` (FilterKnots) says what is kept besides what the RTS smoother needs;
+/// std::invalid_argument for kLast with run_rts.
 /// Initialisation per config.init.source (kGiven: config.init.state at its time, IMU
 /// errors from config.init.imu_errors when any is non-zero, else from the state;
 /// kStaticAlignment: coarse alignment over the first static_duration_s of IMU data,
@@ -95,12 +106,12 @@ struct FilterResult {
 /// (kGiven without a state, kVector magnetometer mode without a field).
 FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, bool run_rts,
                        const std::function<void(const NavEpoch&)>& output, std::ostream* progress,
-                       bool keep_covariances = false);
+                       FilterKnots knots = FilterKnots::kAll);
 
 /// The filter from a given start (InitialFilterState, run before it): the same as above
 /// without the alignment step.
 FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, const FilterStart& start,
                        bool run_rts, const std::function<void(const NavEpoch&)>& output,
-                       std::ostream* progress, bool keep_covariances = false);
+                       std::ostream* progress, FilterKnots knots = FilterKnots::kAll);
 
 }  // namespace navtwin::gnss_ins

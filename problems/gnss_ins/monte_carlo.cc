@@ -119,7 +119,7 @@ void RunAdapted(const McRecord& r, const FilterStart& start, const Solution& bat
     rts_adapted->quantities = rts.quantities;
     return;
   }
-  FilterResult fr = RunFilter(r.inputs, adapted.config, start, true, {}, nullptr, /*keep_covariances=*/true);
+  FilterResult fr = RunFilter(r.inputs, adapted.config, start, true, {}, nullptr, FilterKnots::kAllWithCovariances);
   filter_adapted->run_time_s = fr.filter.run_time_s;
   filter_adapted->quantities = QuantitiesOf(fr.filter, &fr.filter_covariances, r.truth, grid);
   if (!fr.rts) throw std::runtime_error("the filter returned no RTS solution");
@@ -157,7 +157,7 @@ mc::RunRecord GnssInsMcRun(const GnssInsMcSetup& setup, std::uint64_t seed, int 
   try {
     const FilterStart start = InitialFilterState(r.inputs, r.config, nullptr);
     const bool smooth = Wants(setup, "rts") || Wants(setup, "batch") || adapted;
-    FilterResult fr = RunFilter(r.inputs, r.config, start, smooth, {}, nullptr, /*keep_covariances=*/true);
+    FilterResult fr = RunFilter(r.inputs, r.config, start, smooth, {}, nullptr, FilterKnots::kAllWithCovariances);
     filter.run_time_s = fr.filter.run_time_s;
     filter.quantities = QuantitiesOf(fr.filter, &fr.filter_covariances, r.truth, grid);
     failing_from = 1;

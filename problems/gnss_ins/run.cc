@@ -133,9 +133,10 @@ void RunEstimators(const RunSinks& sinks, GnssInsRun* run) {
   // The alignment runs once, before the filter; the batch's prior is the same start.
   const FilterStart start = InitialFilterState(inputs, config, options.progress);
   const MethodSinks filter_sinks = sinks.Open("filter");
+  // Without a smoother nothing reads the filter's knots but the last: memory stays flat.
   FilterResult fr = RunFilter(inputs, config, start, run_rts,
-                              Feed(filter_sinks, run_rts ? nullptr : sinks.writer, config),
-                              options.progress);
+                              Feed(filter_sinks, run_rts ? nullptr : sinks.writer, config), options.progress,
+                              run_rts ? FilterKnots::kAll : FilterKnots::kLast);
   run->methods.push_back(Scored("filter", std::move(fr.filter), filter_sinks, true));
   run->output_method = "filter";
   if (!run_rts) return;

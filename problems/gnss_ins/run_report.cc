@@ -407,7 +407,7 @@ void WriteRunSummary(JsonWriter& w, const RunOptions& options, const GnssInsRun&
   if (!options.truth.empty()) w.Field("truth", options.truth);
   w.Key("methods").BeginObject();
   for (const MethodRun& m : run.methods) {
-    w.Key(m.name).BeginObject().Field("run_time_s", m.solution.run_time_s).Field("knots", m.solution.epochs.size());
+    w.Key(m.name).BeginObject().Field("run_time_s", m.solution.run_time_s).Field("knots", m.solution.epochs.size() + m.solution.knots_not_kept);
     w.Key("counts").BeginObject();
     for (const auto& [key, count] : m.solution.counts) {
       w.Key(key).BeginObject().Field("used", count.used).Field("rejected", count.rejected).EndObject();
@@ -455,7 +455,7 @@ std::string RunTable(const RunOptions& options, const GnssInsRun& run) {
   if (!scored) {
     Append(&s, "%-14s %9s %9s\n", "method", "knots", "run [s]");
     for (const MethodRun& m : run.methods) {
-      Append(&s, "%-14s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size(), m.solution.run_time_s);
+      Append(&s, "%-14s %9zu %9.2f\n", m.name.c_str(), m.solution.epochs.size() + m.solution.knots_not_kept, m.solution.run_time_s);
     }
     AppendParameters(&s, run);
     AppendResidualStats(&s, run);

@@ -51,6 +51,9 @@ struct Solution {
   /// deviations: for the filter the epochs after each update and at least every
   /// FilterConfig::store_interval_s; for the batch its parameter epochs.
   std::vector<NavEpoch> epochs;
+  /// Knots the estimator computed but did not keep (the filter with FilterKnots::kLast);
+  /// the knots computed are epochs.size() + knots_not_kept.
+  std::size_t knots_not_kept = 0;
   /// Keys: "gnss_position", "gnss_velocity", "mag", "baro", "zupt".
   std::map<std::string, MeasurementCount> counts;
   /// Per residual group: the sources' count keys or their axis groups ("gnss_position_h",

@@ -287,6 +287,34 @@ TEST(GnssInsFilter, GnssBetweenImuSamplesIsUsedAtItsOwnTime) {
   }
 }
 
+// FilterKnots::kLast keeps the newest knot only (memory flat in the record's length) and
+// counts the others; the run is otherwise the same: same last knot, same outputs.
+TEST(GnssInsFilter, KeepingOnlyTheLastKnotChangesNothingElse) {
+  const sim::Scenario scenario = ScenarioFromYaml(kOffsetGnssScenario);
+  const SimRecord r = SimulateRecord(scenario, 3, /*perfect=*/false);
+  GnssInsConfig c;
+  c.init.state = InsState{r.init, ImuErrors{}};
+  std::vector<NavEpoch> out_all, out_last;
+  const FilterResult all =
+      RunFilter(r.inputs, c, false, [&](const NavEpoch& e) { out_all.push_back(e); }, nullptr, FilterKnots::kAll);
+  const FilterResult last =
+      RunFilter(r.inputs, c, false, [&](const NavEpoch& e) { out_last.push_back(e); }, nullptr, FilterKnots::kLast);
+  ASSERT_GT(all.filter.epochs.size(), 10u);
+  ASSERT_EQ(last.filter.epochs.size(), 1u);
+  EXPECT_EQ(last.filter.knots_not_kept, all.filter.epochs.size() - 1);
+  EXPECT_EQ(all.filter.knots_not_kept, 0u);
+  const NavEpoch& a = all.filter.epochs.back();
+  const NavEpoch& b = last.filter.epochs.back();
+  EXPECT_EQ(a.state.nav.t_s, b.state.nav.t_s);
+  EXPECT_EQ(a.state.nav.lat_rad, b.state.nav.lat_rad);  // the same arithmetic: bit-equal
+  EXPECT_EQ(a.state.nav.h_m, b.state.nav.h_m);
+  EXPECT_EQ(a.std, b.std);
+  ASSERT_EQ(out_all.size(), out_last.size());
+  EXPECT_EQ(out_all.back().state.nav.lon_rad, out_last.back().state.nav.lon_rad);
+  EXPECT_EQ(all.filter.measurement_residuals.size(), last.filter.measurement_residuals.size());
+  EXPECT_THROW(RunFilter(r.inputs, c, true, {}, nullptr, FilterKnots::kLast), std::invalid_argument);
+}
+
 TEST(GnssInsFilter, OutputAtEveryImuEpochCountsAndProgress) {
   const SimRecord& r = PresetRecord("mems-gps-mag-level-flight");
   GnssInsConfig c = MemsConfig(r);

@@ -101,7 +101,7 @@ RunNees OneRun(const sim::Scenario& scenario, std::uint64_t seed, const std::vec
   x0 = ApplyCorrection(x0, -dx0);  // error = truth - estimate = dx0
   c.init.state = x0;
 
-  const FilterResult result = RunFilter(in, c, true, {}, nullptr, /*keep_covariances=*/true);
+  const FilterResult result = RunFilter(in, c, true, {}, nullptr, FilterKnots::kAllWithCovariances);
   RunNees out;
   for (const double t : check_s) {
     const std::vector<NavEpoch>& knots = result.filter.epochs;
