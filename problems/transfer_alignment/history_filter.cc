@@ -118,9 +118,12 @@ class HistoryFilter {
     const double dt = s.dt_s;
     InstrumentColumns phi_xi;
     const TransferMatrix phi_xx = TransferTransition(ins_.state(), s, &phi_xi);
-    acc_xi_ = phi_xx * acc_xi_ + phi_xi;
-    acc_xx_ = phi_xx * acc_xx_;
-    acc_q_ = phi_xx * acc_q_ * phi_xx.transpose();
+    // Coefficient-based products: fixed 10 x 10 and 10 x 18 blocks, where the blocked
+    // GEMM's packing costs more than the arithmetic (per IMU sample).
+    acc_xi_ = phi_xx.lazyProduct(acc_xi_) + phi_xi;
+    acc_xx_ = phi_xx.lazyProduct(acc_xx_);
+    const TransferMatrix phi_q = phi_xx.lazyProduct(acc_q_);
+    acc_q_ = phi_q.lazyProduct(phi_xx.transpose());
     acc_q_.diagonal() += q_ * dt;
     ins_.Update(s);
     PushNode();
@@ -136,9 +139,14 @@ class HistoryFilter {
     auto Pxi = P_.block<kTransferStates, kInstrumentStates>(0, kInstr);
     const auto Pii = P_.block<kInstrumentStates, kInstrumentStates>(kInstr, kInstr);
     const InstrumentColumns Pxi0 = Pxi;
-    const TransferMatrix cross = acc_xx_ * Pxi0 * acc_xi_.transpose();
-    Pxx = acc_xx_ * Pxx * acc_xx_.transpose() + cross + cross.transpose() + acc_xi_ * Pii * acc_xi_.transpose() + acc_q_;
-    Pxi = acc_xx_ * Pxi0 + acc_xi_ * Pii;
+    const Eigen::Matrix<double, kInstrumentStates, kInstrumentStates> Pii0 = Pii;
+    const InstrumentColumns A_Pxi = acc_xx_.lazyProduct(Pxi0);
+    const InstrumentColumns B_Pii = acc_xi_.lazyProduct(Pii0);
+    const TransferMatrix Pxx0 = Pxx;
+    const TransferMatrix cross = A_Pxi.lazyProduct(acc_xi_.transpose());
+    Pxx = acc_xx_.lazyProduct(Pxx0).lazyProduct(acc_xx_.transpose()) + cross + cross.transpose() +
+          B_Pii.lazyProduct(acc_xi_.transpose()) + acc_q_;
+    Pxi = A_Pxi + B_Pii;
     P_.block<kInstrumentStates, kTransferStates>(kInstr, 0) = Pxi.transpose();
     if (n > 0) {
       // Coefficient-wise (lazy) products: the blocks are a few tens wide, where the blocked
@@ -302,9 +310,10 @@ class HistoryFilter {
       if (settled) break;
     }
     // P <- P - K S K^T with K = P H^T S^-1 (the last linearisation): K S K^T = W W^T with
-    // W = P H^T L^-T, S = L L^T (symmetric by construction, entry by entry).
+    // W = P H^T L^-T, S = L L^T.
     const MatrixXd W = S.matrixL().solve(PHt.transpose()).transpose();
-    P_.noalias() -= W.lazyProduct(W.transpose());
+    P_.selfadjointView<Eigen::Lower>().rankUpdate(W, -1.0);  // the lower triangle: half the work
+    P_.triangularView<Eigen::StrictlyUpper>() = P_.transpose();  // exactly symmetric
     Feedback(dx, kin.tag_s);
     return true;
   }
