@@ -538,14 +538,18 @@ FilterResult NavigationFilter::Result(std::chrono::steady_clock::time_point wall
   return result;
 }
 
+void RequireKnotsForRts(FilterKnots knots, bool run_rts) {
+  if (knots == FilterKnots::kLast && run_rts) {
+    throw std::invalid_argument("RunFilter: the RTS smoother needs every knot (FilterKnots::kLast with run_rts)");
+  }
+}
+
 }  // namespace
 
 FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, const FilterStart& start, bool run_rts,
                        const std::function<void(const NavEpoch&)>& output, std::ostream* progress,
                        FilterKnots knots) {
-  if (knots == FilterKnots::kLast && run_rts) {
-    throw std::invalid_argument("RunFilter: the RTS smoother needs every knot (FilterKnots::kLast with run_rts)");
-  }
+  RequireKnotsForRts(knots, run_rts);
   NavigationFilter filter(inputs, config, start, run_rts, knots, output, progress);
   return filter.Run();
 }
@@ -553,6 +557,7 @@ FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, const 
 FilterResult RunFilter(const Inputs& inputs, const GnssInsConfig& config, bool run_rts,
                        const std::function<void(const NavEpoch&)>& output, std::ostream* progress,
                        FilterKnots knots) {
+  RequireKnotsForRts(knots, run_rts);  // before the alignment, not after it
   const FilterStart start = InitialFilterState(inputs, config, progress);
   return RunFilter(inputs, config, start, run_rts, output, progress, knots);
 }
