@@ -133,7 +133,7 @@ class TransferBatch {
   /// delay; re-adds the changed residuals. Returns how many states changed record.
   int SelectRecords();
   void Covariance(TransferBatchSolution* out);
-  /// Priors on the scale factors and axis misalignments (zero sigma: held at zero).
+  /// Priors on the biases, scale factors and axis misalignments (zero sigma: held at zero).
   void InstrumentPriors();
   /// The instrument blocks with a prior (estimated), with their sigma and offset into
   /// TransferBatchSolution::instrument_sigma.
@@ -302,10 +302,6 @@ void TransferBatch::BuildProblem() {
   SelectRecords();
 
   // Priors (see the file comment).
-  problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.gyro_bias_radps),
-                             nullptr, bg_.data());
-  problem_->AddResidualBlock(VectorPrior3::Create(Eigen::Vector3d::Zero(), cfg_.accel_bias_mps2),
-                             nullptr, ba_.data());
   InstrumentPriors();
   const double mis_sigma_rad = cfg_.misalignment_rad;
   problem_->AddResidualBlock(
@@ -335,8 +331,10 @@ std::vector<TransferBatch::InstrumentBlock> TransferBatch::InstrumentBlocks() {
   const InstrumentPrior sigma = InstrumentPriorSigma(cfg_);
   return {{sg_.data(), 3, sigma(istate::kSg), istate::kSg, "gyro", 0},
           {mg_.data(), 6, sigma(istate::kMg), istate::kMg, "gyro", 3},
+          {bg_.data(), 3, sigma(istate::kBg), istate::kBg, "gyro", 9},
           {sa_.data(), 3, sigma(istate::kSa), istate::kSa, "accel", 0},
-          {ma_.data(), 6, sigma(istate::kMa), istate::kMa, "accel", 3}};
+          {ma_.data(), 6, sigma(istate::kMa), istate::kMa, "accel", 3},
+          {ba_.data(), 3, sigma(istate::kBa), istate::kBa, "accel", 9}};
 }
 
 void TransferBatch::InstrumentPriors() {

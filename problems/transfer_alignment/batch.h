@@ -41,7 +41,7 @@ struct TransferBatchSolution {
   Eigen::Matrix<double, 6, 1> gyro_axis_misalignment_rad = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> accel_axis_misalignment_rad = Eigen::Matrix<double, 6, 1>::Zero();
   /// sigma of the instrument errors, in filter_model.h's istate layout (per triad: scale
-  /// factors, misalignments; gyro, then accelerometer).
+  /// factors, misalignments, bias; gyro, then accelerometer).
   Eigen::Matrix<double, kInstrumentStates, 1> instrument_sigma = Eigen::Matrix<double, kInstrumentStates, 1>::Zero();
   /// The instrument errors the record does not determine, named as TriadParameterName
   /// (core/imu_error_model.h) gives them ("accel.scale_factor.x", ...): their posterior

@@ -62,7 +62,7 @@ class TransferFilter {
   TransferFilter(const TransferInputs& in, const TransferConfig& cfg, DelayOrder order)
       : cfg_(cfg), order_(order),
         master_(in.master, DerivativeMode::kCausal, in.master_path, MasterFitRecords(in.master, cfg.master_fit_window_s)),
-        ins_(in.slave_initial), kf_(InitialCovariance(cfg)), q_(TransferProcessNoise(cfg)), slave_imu_(in.slave_imu) {
+        ins_(in.slave_initial), kf_(InitialCovariance(cfg)), q_(TransferProcessNoise(cfg, SlaveBiases::kAsNoise)), slave_imu_(in.slave_imu) {
     misalignment_ = in.misalignment_guess.normalized();
     tau_s_ = cfg.delay_initial_s;
   }

@@ -68,9 +68,10 @@ TransferVector TransferInitialSigma(const TransferConfig& c) {
   return sd;
 }
 
-TransferVector TransferProcessNoise(const TransferConfig& c) {
+TransferVector TransferProcessNoise(const TransferConfig& c, SlaveBiases biases) {
   TransferVector q;
-  const double bg = c.gyro_bias_radps, ba = c.accel_bias_mps2;
+  const bool as_noise = biases == SlaveBiases::kAsNoise;
+  const double bg = as_noise ? c.gyro_bias_radps : 0.0, ba = as_noise ? c.accel_bias_mps2 : 0.0;
   q.segment<3>(tstate::kVel).setConstant(std::pow(c.accel_vrw_mps_per_sqrt_s, 2) + ba * ba * kBiasMemory_s);
   q.segment<3>(tstate::kAtt).setConstant(std::pow(c.gyro_arw_rad_per_sqrt_s, 2) + bg * bg * kBiasMemory_s);
   q.segment<3>(tstate::kMis).setConstant(kMisalignmentWalk_rad_sqrt_s * kMisalignmentWalk_rad_sqrt_s);
@@ -84,6 +85,8 @@ InstrumentPrior InstrumentPriorSigma(const TransferConfig& c) {
   sd.segment<6>(istate::kMg).setConstant(c.gyro_axis_misalignment_rad);
   sd.segment<3>(istate::kSa).setConstant(c.accel_scale_factor);
   sd.segment<6>(istate::kMa).setConstant(c.accel_axis_misalignment_rad);
+  sd.segment<3>(istate::kBg).setConstant(c.gyro_bias_radps);
+  sd.segment<3>(istate::kBa).setConstant(c.accel_bias_mps2);
   return sd;
 }
 
@@ -110,6 +113,8 @@ void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatr
   F_instrument->block<3, 6>(kAtt, istate::kMg) = F_att_bg * MisalignmentColumns(w_s);
   F_instrument->block<3, 3>(kVel, istate::kSa) = F_vel_ba * f_s.asDiagonal();
   F_instrument->block<3, 6>(kVel, istate::kMa) = F_vel_ba * MisalignmentColumns(f_s);
+  F_instrument->block<3, 3>(kAtt, istate::kBg) = F_att_bg;
+  F_instrument->block<3, 3>(kVel, istate::kBa) = F_vel_ba;
 }
 
 TransferMatrix TransferTransition(const NavState& nav, const ImuSample& s, InstrumentColumns* phi_instrument) {

@@ -11,11 +11,12 @@
 //   [9]   dtau_s     delay,           tau_true = tau + dtau
 // dv and phi follow the INS error model of problems/ins/error_dynamics.h (its velocity and
 // attitude rows and columns; the position errors are left out because the position is
-// reset from the master at every record, and the slave biases are not states); mu and
-// dtau are random constants with small random walks. Process noise per state (continuous
-// PSD): q_v = VRW^2 + sigma_ba^2 T_b, q_phi = ARW^2 + sigma_bg^2 T_b, where the unestimated
-// bias is covered by white noise whose variance grows like the bias's effect over the
-// filter's memory T_b: sigma_b^2 T_b^2 = q T_b.
+// reset from the master at every record); mu and dtau are random constants with small
+// random walks. Process noise per state (continuous PSD): q_v = VRW^2 + sigma_ba^2 T_b,
+// q_phi = ARW^2 + sigma_bg^2 T_b in the order filters, where the slave biases are not
+// states and are covered by white noise whose variance grows like the bias's effect over
+// the filter's memory T_b: sigma_b^2 T_b^2 = q T_b. The history filter carries the biases
+// (with the other instrument errors, istate below) and has only VRW^2 and ARW^2.
 #pragma once
 
 #include <cstddef>
@@ -24,6 +25,7 @@
 
 #include <Eigen/Core>
 
+#include "core/imu_error_model.h"
 #include "core/types.h"
 #include "problems/ins/error_dynamics.h"
 #include "problems/transfer_alignment/config.h"
@@ -55,32 +57,40 @@ int MasterFitRecords(const std::vector<NavState>& master, double window_s);
 /// sqrt diag of the initial covariance: initial_velocity, initial_attitude, misalignment, delay.
 TransferVector TransferInitialSigma(const TransferConfig& config);
 
+/// How a filter treats the slave's gyro and accelerometer biases: as white process noise
+/// over a memory of seconds (the order filters, header comment), or as states (the history
+/// filter: istate::kBg, istate::kBa), when they add no process noise.
+enum class SlaveBiases { kAsNoise, kAsStates };
+
 /// Continuous process-noise PSD per state (header comment).
-TransferVector TransferProcessNoise(const TransferConfig& config);
+TransferVector TransferProcessNoise(const TransferConfig& config, SlaveBiases biases);
 
 /// The slave triads' instrument errors as filter states (history_filter.h): per triad its
-/// scale factors s (3) and axis misalignments M (6) in the order of core/imu_error_model.h's
-/// triad block (whose first 9 entries they are, so TriadMatrix reads them), gyro then
-/// accelerometer; random constants.
-constexpr int kInstrumentStates = 18;
+/// scale factors s (3), axis misalignments M (6) and bias b (3), exactly core/imu_error_model.h's
+/// triad block (so TriadMatrix and TriadBias read them), gyro then accelerometer; random
+/// constants.
+constexpr int kInstrumentStates = 2 * kTriadParameters;
 using InstrumentColumns = Eigen::Matrix<double, kTransferStates, kInstrumentStates>;
 namespace istate {
-constexpr int kSg = 0;   ///< gyro triad: scale factors, then
-constexpr int kMg = 3;   ///< its misalignments
-constexpr int kSa = 9;   ///< accelerometer triad: scale factors, then
-constexpr int kMa = 12;  ///< its misalignments
+constexpr int kSg = 0;                      ///< gyro triad: scale factors, then
+constexpr int kMg = 3;                      ///< its misalignments, then
+constexpr int kBg = 9;                      ///< its bias (rad/s)
+constexpr int kSa = kTriadParameters;       ///< accelerometer triad: scale factors, then
+constexpr int kMa = kTriadParameters + 3;   ///< its misalignments, then
+constexpr int kBa = kTriadParameters + 9;   ///< its bias (m/s^2)
 }  // namespace istate
 
 using InstrumentPrior = Eigen::Matrix<double, kInstrumentStates, 1>;
 
 /// The prior sigma of each instrument error (istate layout) from the configuration's
-/// gyro/accel scale-factor and axis-misalignment sigmas.
+/// gyro/accel scale-factor, axis-misalignment and bias sigmas.
 InstrumentPrior InstrumentPriorSigma(const TransferConfig& config);
 
-/// F as below and d(dx_dot)/d(instrument errors) (10 x 18): a gyro error matrix E_g acts as
-/// a bias E_g omega, so its columns are F's gyro-bias columns (ins::ErrorDynamicsF) times
-/// diag(omega) (sg) and MisalignmentColumns(omega) (mg); the accelerometer's likewise
-/// with f. omega and f from the sample (already corrected for the current estimates).
+/// F as below and d(dx_dot)/d(instrument errors) (10 x 24): the biases' columns are F's
+/// gyro- and accelerometer-bias columns (ins::ErrorDynamicsF); a gyro error matrix E_g acts
+/// as a bias E_g omega, so its columns are the gyro-bias columns times diag(omega) (sg) and
+/// MisalignmentColumns(omega) (mg); the accelerometer's likewise with f. omega and f from
+/// the sample (already corrected for the current estimates).
 void TransferErrorDynamics(const NavState& nav, const ImuSample& s, TransferMatrix* F,
                            InstrumentColumns* F_instrument);
 

@@ -65,7 +65,7 @@ class HistoryFilter {
         master_(in.master, DerivativeMode::kCausal, in.master_path,
                 MasterFitRecords(in.master, cfg.master_fit_window_s)),
         ins_(in.slave_initial),
-        q_(TransferProcessNoise(cfg)),
+        q_(TransferProcessNoise(cfg, SlaveBiases::kAsStates)),
         slave_imu_(in.slave_imu) {
     CheckTransferFilterConfig(cfg, "RunHistoryFilter");
     misalignment_ = in.misalignment_guess.normalized();
@@ -92,12 +92,12 @@ class HistoryFilter {
   std::size_t clones() const { return clone_t_.size(); }
   static int CloneOffset(std::size_t j) { return kPresent + kCloneSize * static_cast<int>(j); }
 
-  /// The raw sample corrected for the estimated scale factors and axis misalignments:
-  /// K^-1 x with K = I + diag(s) + M (core/imu_error_model.h), K^-1 kept from the last update.
+  /// The raw sample corrected for the estimated instrument errors: K^-1 (x - b dt) with
+  /// K = I + diag(s) + M (core/imu_error_model.h), K^-1 kept from the last update.
   ImuSample CorrectInstrument(const ImuSample& raw) const {
     ImuSample c = raw;
-    c.dtheta_b_rad = gyro_correction_ * raw.dtheta_b_rad;
-    c.dv_b_mps = accel_correction_ * raw.dv_b_mps;
+    c.dtheta_b_rad = gyro_correction_ * (raw.dtheta_b_rad - TriadBias(instrument_.data() + istate::kSg) * raw.dt_s);
+    c.dv_b_mps = accel_correction_ * (raw.dv_b_mps - TriadBias(instrument_.data() + istate::kSa) * raw.dt_s);
     return c;
   }
 
@@ -107,18 +107,18 @@ class HistoryFilter {
     nodes_.push_back({s.t_s, s.q_n_b, s.v_n_mps});
   }
 
-  // The present [x (10), instrument errors (18)] moves with [[Phi_xx, Phi_xi], [0, I]]
+  // The present [x (10), instrument errors (24)] moves with [[Phi_xx, Phi_xi], [0, I]]
   // (filter_model.h TransferTransition). P is not touched per sample: the
   // product of the transitions since the last update, [[A, B], [0, I]], and the process
   // noise carried through them, Q_acc, are accumulated, and applied once at the next
   // update (FlushPropagation) -- the same result as sample by sample, at a fraction of the
-  // cost with 28 states and the clones.
+  // cost with 34 states and the clones.
   void Propagate(const ImuSample& raw) {
     const ImuSample s = CorrectInstrument(raw);
     const double dt = s.dt_s;
     InstrumentColumns phi_xi;
     const TransferMatrix phi_xx = TransferTransition(ins_.state(), s, &phi_xi);
-    // Coefficient-based products: fixed 10 x 10 and 10 x 18 blocks, where the blocked
+    // Coefficient-based products: fixed 10 x 10 and 10 x 24 blocks, where the blocked
     // GEMM's packing costs more than the arithmetic (per IMU sample).
     acc_xi_ = phi_xx.lazyProduct(acc_xi_) + phi_xi;
     acc_xx_ = phi_xx.lazyProduct(acc_xx_);
@@ -361,7 +361,7 @@ class HistoryFilter {
   double tau_s_ = 0.0;
   TransferVector q_;  // continuous process-noise PSD per state
   const std::vector<ImuSample>& slave_imu_;
-  MatrixXd P_;  // [present: x (10), instrument errors (18); clone 0 (6), clone 1 (6), ...]
+  MatrixXd P_;  // [present: x (10), instrument errors (24); clone 0 (6), clone 1 (6), ...]
   // Transition since the last update, not yet in the present-clone cross blocks:
   // [[acc_xx_, acc_xi_], [0, I]].
   TransferMatrix acc_xx_;

@@ -8,9 +8,9 @@
 // docs/transfer-alignment.md, "Delayed-state fusion", has the derivation.
 //
 // State: the 10 error states of filter_model.h (dv, phi of the slave now, mu, dtau), the
-// slave triads' scale factors and axis misalignments (18, filter_model.h's instrument
-// states; priors from the configuration, as the batch's; their estimates correct every
-// sample before the strapdown) and, per clone j, the slave's [dv, phi] at the clone's time
+// slave triads' scale factors, axis misalignments and biases (24, filter_model.h's
+// instrument states; random constants with the batch's priors from the configuration;
+// their estimates correct every sample before the strapdown) and, per clone j, the slave's [dv, phi] at the clone's time
 // c_j (6 each). A clone is taken at the start and after an update when the newest is
 // kCloneSpacing_s old (at a record's tag); clones older than the
 // history the delay needs (|tau| + 4 sigma_tau + a margin, at most

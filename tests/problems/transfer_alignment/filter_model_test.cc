@@ -15,13 +15,15 @@ namespace navtwin::transfer {
 namespace transfer_filter_model_test {
 
 /// One strapdown step from `start` with the sample measured by a triad with instrument
-/// errors e ([sg, sa, mg, ma]); returns the error (true minus estimate) [dv, phi] after it,
+/// errors e (istate layout: per triad K = I + diag(s) + M and the bias b, x_m = K x + b dt);
+/// returns the error (true minus estimate) [dv, phi] after it,
 /// the truth being the same step with the exact sample.
 Eigen::Matrix<double, 6, 1> StepError(const NavState& start, const ImuSample& exact,
                                       const Eigen::Matrix<double, kInstrumentStates, 1>& e) {
   ImuSample measured = exact;
-  measured.dtheta_b_rad = TriadMatrix(e.data() + istate::kSg) * exact.dtheta_b_rad;
-  measured.dv_b_mps = TriadMatrix(e.data() + istate::kSa) * exact.dv_b_mps;
+  measured.dtheta_b_rad =
+      TriadMatrix(e.data() + istate::kSg) * exact.dtheta_b_rad + TriadBias(e.data() + istate::kSg) * exact.dt_s;
+  measured.dv_b_mps = TriadMatrix(e.data() + istate::kSa) * exact.dv_b_mps + TriadBias(e.data() + istate::kSa) * exact.dt_s;
   Strapdown truth(start), estimate(start);
   truth.Update(exact);
   estimate.Update(measured);
