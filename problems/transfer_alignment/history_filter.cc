@@ -12,6 +12,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "core/earth.h"
 #include "core/rotation.h"
 #include "core/imu_error_model.h"
 #include "core/strapdown.h"
@@ -48,6 +49,20 @@ constexpr double kHistoryMargin_s = 0.1;
 // the slave's newest IMU interval extrapolated (the linearisation of the model about the
 // present), up to this lead; further, the record is not used.
 constexpr double kMaxLead_s = 0.5;
+
+/// Velocity-match variance per NED axis that the linearisation in the delay leaves out: the
+/// delay column carries the nominal slave's acceleration a_s = (v_n1 - v_n0) / h, which
+/// differs from the true one by -[f x] phi (f = a_s - g_n, the specific force, and phi the
+/// attitude error); the neglected product [f x] phi dtau, of two independent zero-mean
+/// errors, has variance sigma_tau^2 diag([f x] P_phi [f x]^T). It matters while both are
+/// large (an acquisition with a precise master: the nominal's own drift would otherwise be
+/// read as motion that fixes the delay) and vanishes as they converge.
+Vector3d DelayLinearisationVariance(const HistoryBracket& b, const Vector3d& g_n, const Matrix3d& P_phi,
+                                    double var_tau) {
+  const Vector3d f_n = (b.n1.v_n_mps - b.n0.v_n_mps) / (b.n1.t_s - b.n0.t_s) - g_n;
+  const Matrix3d F = Skew<double>(f_n);
+  return (F * P_phi * F.transpose()).diagonal() * std::max(var_tau, 0.0);
+}
 
 /// Position of s in a sorted sequence of times: the segment [i0, i0 + 1] that holds s, or
 /// the first / last segment when s is outside (the caller extrapolates).
@@ -261,10 +276,9 @@ class HistoryFilter {
   /// data time lies outside the history.
   bool Correct(const MasterKinematics& kin, Eigen::Matrix<double, 6, 1>* r0, double* nis0) {
     const int N = static_cast<int>(P_.rows());
-    const Vector6 inv_sigma = (Vector6() << Vector3d::Constant(cfg_.master_velocity_mps),
-                               Vector3d::Constant(cfg_.master_attitude_rad))
-                                  .finished()
-                                  .cwiseInverse();
+    const NavState& now = ins_.state();
+    const Vector3d g_n = wgs84::GravityNed(now.lat_rad, now.h_m);
+    Vector6 inv_sigma;
     VectorXd dx = VectorXd::Zero(N);
     MatrixXd PHt(N, 6);
     Eigen::LLT<Eigen::Matrix<double, 6, 6>> S;  // of H P H^T + I (whitened)
@@ -281,7 +295,12 @@ class HistoryFilter {
       Vector6 r;
       Eigen::Matrix<double, 6, kHistoryColumns> H;
       HistoryMatchResidualAndJacobian(b, M_i, kin, tau_i, cfg_.lever_arm_b_m, &r, &H);
-      if (it == 0) *r0 = r;
+      if (it == 0) {
+        *r0 = r;
+        const Vector3d var_v = Vector3d::Constant(cfg_.master_velocity_mps * cfg_.master_velocity_mps) +
+                               DelayLinearisationVariance(b, g_n, P_.block<3, 3>(o0 + 3, o0 + 3), P_(kTau, kTau));
+        inv_sigma << var_v.cwiseSqrt().cwiseInverse(), Vector3d::Constant(1.0 / cfg_.master_attitude_rad);
+      }
       H = inv_sigma.asDiagonal() * H;
       const int idx[4] = {o0, o1, kMis, kTau};
       const int len[4] = {kCloneSize, kCloneSize, 3, 1};
