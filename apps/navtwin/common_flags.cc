@@ -19,7 +19,7 @@ DEFINE_int32(threads, 2, "Monte Carlo worker threads (0: all cores); the results
 DEFINE_string(errors_csv, "", "Monte Carlo: write every run's errors of every method to this CSV");
 DEFINE_string(method, "",
               "Estimation method: inflight-align distance, kalman, batch or all; transfer-align order1, order2, "
-              "batch or all; transfer-align-ansfl order2 or batch; calibrate-imu batch or recursive; calibrate-mag "
+              "history, batch or all; transfer-align-ansfl order2, history or batch; calibrate-imu batch or recursive; calibrate-mag "
               "ellipsoid, planar, bidirectional or recursive");
 DEFINE_bool(demo, false,
             "Simulate a built-in demo into --out and run on it with truth (ins: a 10-min flight; smooth: "

@@ -320,8 +320,9 @@ CoarseAlignment CoarseAlignAnsfl(const std::vector<ImuSample>& dot_imu, const st
 //    gyro (120 Hz; the drone's motion, < 2 Hz, barely enters them): per-axis sigma 1.4-1.6
 //    deg/s per sample, i.e. 0.13 deg/s/sqrt(Hz) = 8 deg/sqrt(h). The data sheet's 0.007
 //    deg/s/sqrt(Hz) (0.4 deg/sqrt(h)) is at rest; the rotor vibration dominates in flight.
-//  - accelerometer bias 10 mg: consumer MEMS after the factory calibration (not estimated by
-//    the filter, which covers it by noise).
+//  - accelerometer bias 10 mg: consumer MEMS after the factory calibration (the order-2
+//    filter covers the biases by process noise; the history filter and the batch estimate
+//    them with these priors).
 //  - VRW 7 m/s/sqrt(h): likewise measured in flight, 1.1-1.3 m/s^2 per sample and per axis
 //    (0.1-0.12 m/s^2/sqrt(Hz), white: the 12-sample means scale as 1/sqrt(12)); the data
 //    sheet's 120 ug/sqrt(Hz) (0.07 m/s/sqrt(h)) is 100 times smaller.
