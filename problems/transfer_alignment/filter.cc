@@ -73,6 +73,7 @@ class TransferFilter {
     WalkSlaveImu(
         slave_imu_, master_, ins_.state().t_s, [this](const ImuSample& s) { Propagate(s); },
         [this, out](std::size_t k) { Update(k, out); });
+    out->truncation_bound = TruncationBound();
   }
 
  private:
@@ -122,6 +123,7 @@ class TransferFilter {
       if (!dx_i.allFinite()) Fail(kin.tag_s, "the iterated correction");
     }
     r = r0;
+    AccumulateTruncation(SeriesRemainder(k), sigma, Hw);
     const ErrorStateKalmanFilter::Update u = kf_.Correct(y, Hw, kGateProbability);
     const Eigen::VectorXd& dx = u.dx;
     if (!dx.allFinite()) Fail(kin.tag_s, "the state correction");
@@ -146,36 +148,66 @@ class TransferFilter {
     out->epochs.push_back(e);
   }
 
+  /// The first neglected term of the compensation series at record k, per channel, as a
+  /// polynomial in the delay: |term| = sum_n c_n tau^n (c indexed by the power, 0..3).
+  /// Order 1: |omega_dot| tau^2 / 2 and |a| tau + |a_dot| tau^2 / 2; order 2: |omega_ddot|
+  /// tau^3 / 6 and |a_ddot| tau^3 / 6, the third derivatives by a backward difference of the
+  /// second (none at the first record).
+  struct Remainder {
+    Eigen::Vector4d att = Eigen::Vector4d::Zero();  // rad
+    Eigen::Vector4d vel = Eigen::Vector4d::Zero();  // m/s
+  };
+  Remainder SeriesRemainder(std::size_t k) const {
+    const MasterKinematics& m = master_.kinematics(k);
+    Remainder rem;
+    if (order_ == DelayOrder::kFirst) {
+      rem.att(2) = m.omega_dot_nb_b_radps2.norm() / 2.0;
+      rem.vel(1) = m.a_n_mps2.norm();
+      rem.vel(2) = m.a_dot_n_mps3.norm() / 2.0;
+      return rem;
+    }
+    if (k == 0) return rem;
+    const MasterKinematics& p = master_.kinematics(k - 1);
+    const double dt = m.tag_s - p.tag_s;
+    rem.att(3) = ((m.omega_dot_nb_b_radps2 - p.omega_dot_nb_b_radps2) / dt).norm() / 6.0;
+    rem.vel(3) = ((m.a_dot_n_mps3 - p.a_dot_n_mps3) / dt).norm() / 6.0;
+    return rem;
+  }
+  static Eigen::Vector4d Powers(double tau) { return Eigen::Vector4d(1.0, tau, tau * tau, tau * tau * tau); }
+
   // Per-axis 1-sigma of the velocity and attitude matching at record k (see the header
   // comment, "measurement noise"): the master's noise, the velocity noise through the
   // differentiator's gain, and the truncation error of the compensation series estimated
   // by its first neglected term at the delay tau_eff = |tau| + sigma_tau.
   Eigen::Matrix<double, 6, 1> MeasurementSigma(std::size_t k) const {
-    const MasterKinematics& m = master_.kinematics(k);
     const double tau = std::abs(tau_s_) + std::sqrt(kf_.P()(kTau, kTau));
-    // Third derivatives by a backward difference of the second (record k-1 when it exists).
-    Vector3d omega_ddot = Vector3d::Zero(), a_ddot = Vector3d::Zero();
-    double dt = 0.0;
-    if (k > 0) {
-      const MasterKinematics& p = master_.kinematics(k - 1);
-      dt = m.tag_s - p.tag_s;
-      omega_ddot = (m.omega_dot_nb_b_radps2 - p.omega_dot_nb_b_radps2) / dt;
-      a_ddot = (m.a_dot_n_mps3 - p.a_dot_n_mps3) / dt;
-    }
-    double trunc_att = 0.0, trunc_vel = 0.0, gain_v = 1.0;
-    if (order_ == DelayOrder::kFirst) {
-      trunc_att = m.omega_dot_nb_b_radps2.norm() * tau * tau / 2.0;
-      trunc_vel = m.a_n_mps2.norm() * tau + m.a_dot_n_mps3.norm() * tau * tau / 2.0;
-    } else {
-      trunc_att = omega_ddot.norm() * tau * tau * tau / 6.0;
-      trunc_vel = a_ddot.norm() * tau * tau * tau / 6.0;
-      // The weights of the v_j in v_k + tau a_k + tau^2/2 a_dot_k (differences or the fit).
-      gain_v = master_.VelocityNoiseGain(tau, order_);
-    }
+    const Remainder rem = SeriesRemainder(k);
+    const double trunc_att = rem.att.dot(Powers(tau)), trunc_vel = rem.vel.dot(Powers(tau));
+    // The weights of the v_j in v_k + tau a_k + tau^2/2 a_dot_k (differences or the fit).
+    const double gain_v = order_ == DelayOrder::kFirst ? 1.0 : master_.VelocityNoiseGain(tau, order_);
     Eigen::Matrix<double, 6, 1> sigma;
     sigma.head<3>().setConstant(std::hypot(gain_v * cfg_.master_velocity_mps, trunc_vel));
     sigma.tail<3>().setConstant(std::hypot(cfg_.master_attitude_rad, trunc_att));
     return sigma;
+  }
+
+  // The bounds of the misalignment's and the delay's bias by the series' truncation
+  // (filter.h, TransferFilterRun::truncation_bound). Per record: the whitened squared norm
+  // of the remainder as a quadratic form in the powers of tau, and the information the
+  // record gives each of mu and tau, |column of H / sigma|^2.
+  void AccumulateTruncation(const Remainder& rem, const Eigen::Matrix<double, 6, 1>& sigma, const Eigen::MatrixXd& Hw) {
+    truncation_form_ += rem.vel * rem.vel.transpose() / (sigma(0) * sigma(0)) +
+                        rem.att * rem.att.transpose() / (sigma(3) * sigma(3));
+    information_ += Hw.middleCols<4>(kMis).colwise().squaredNorm().transpose();
+  }
+  Eigen::Vector4d TruncationBound() const {
+    const Eigen::Vector4d t = Powers(std::abs(tau_s_) + std::sqrt(std::max(kf_.P()(kTau, kTau), 0.0)));
+    const double remainder = std::max(t.dot(truncation_form_ * t), 0.0);
+    Eigen::Vector4d bound = Eigen::Vector4d::Zero();
+    for (int i = 0; i < 4; ++i) {
+      if (information_(i) > 0.0) bound(i) = std::sqrt(remainder / information_(i));
+    }
+    return bound;
   }
 
   [[noreturn]] static void Fail(double t_s, const char* what) { ThrowNonFinite("RunTransferFilter", t_s, what); }
@@ -189,6 +221,8 @@ class TransferFilter {
   double tau_s_ = 0.0;
   Vector10 q_;  // continuous process-noise PSD per state
   const std::vector<ImuSample>& slave_imu_;
+  Eigen::Matrix4d truncation_form_ = Eigen::Matrix4d::Zero();  // sum of c c^T / sigma^2
+  Eigen::Vector4d information_ = Eigen::Vector4d::Zero();       // sum of |H_(mu, tau) / sigma|^2
 };
 
 }  // namespace

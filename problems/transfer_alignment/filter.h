@@ -52,6 +52,18 @@ struct TransferFilterRun {
   std::size_t records_outside_history = 0;
   /// After the last update: the joint covariance of [mu (3), dtau].
   Eigen::Matrix4d misalignment_delay_covariance = Eigen::Matrix4d::Zero();
+  /// Order filters: bounds of the misalignment's and the delay's bias by the compensation
+  /// series' truncation, [mu_b_rad (3), tau_s], which the covariance does not hold. Each
+  /// record's remainder r_k (the first neglected term, at the final delay) is not noise: on
+  /// a manoeuvre it is in phase with the delay's own column (a sine's remainder
+  /// -A w^3 tau^3 / 6 cos wt against H_tau = A w cos wt), so it biases the estimate alike at
+  /// every record and the covariance, shrinking as 1/N, cannot cover it. A least-squares
+  /// estimate of one parameter with residual remainders r_k is biased by sum h_k r_k / sum
+  /// h_k^2 <= sqrt(sum |r_k|^2 / sum |h_k|^2) (Cauchy-Schwarz; h_k its column of H, all
+  /// whitened): that bound per parameter. The first neglected term understates the remainder
+  /// where the series does not converge (omega tau near 1); the innovations show it there.
+  /// Zero for the history filter (no series).
+  Eigen::Vector4d truncation_bound = Eigen::Vector4d::Zero();
   double run_time_s = 0.0;
 };
 

@@ -110,10 +110,23 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
               " master records not used (data time outside the slave history kept)";
   }
   r.delay_s = last.delay_s;
-  r.delay_sigma_s = last.sigma[9];
   r.misalignment_deg = EulerOf(last.misalignment) * kRadToDeg;
-  r.misalignment_sigma_mrad = last.sigma.segment<3>(6) / kMrad_rad;
-  ScoreConsistency(inputs, last.misalignment, last.delay_s, run.misalignment_delay_covariance, &r);
+  // The order filters' sigma carry the series' truncation bounds (filter.h).
+  const Eigen::Vector4d& bound = run.truncation_bound;
+  Eigen::Matrix4d covariance = run.misalignment_delay_covariance;
+  covariance.diagonal() += bound.cwiseAbs2();
+  const Eigen::Vector4d sigma = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  r.misalignment_sigma_mrad = sigma.head<3>() / kMrad_rad;
+  r.delay_sigma_s = sigma(3);
+  if (bound.maxCoeff() > 0.0) {
+    std::ostringstream note;
+    note << "; sigma include the compensation series' truncation bounds: misalignment "
+         << (bound.head<3>() / kMrad_rad).transpose() << " mrad, delay " << bound(3) * 1e3
+         << " ms (the covariance alone: " << (last.sigma.segment<3>(6) / kMrad_rad).transpose() << " mrad, "
+         << last.sigma[9] * 1e3 << " ms)";
+    r.note += note.str();
+  }
+  ScoreConsistency(inputs, last.misalignment, last.delay_s, covariance, &r);
   return r;
 }
 
