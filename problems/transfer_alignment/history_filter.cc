@@ -41,8 +41,10 @@ constexpr double kSettledDelay_s = 1e-6;
 constexpr double kSettledAngle_rad = 1e-6;
 constexpr double kSettledVelocity_mps = 1e-6;
 // Spacing of the clones (s): the error between two clones is interpolated linearly, and the
-// error state changes little over it (f x phi dt: 50 m/s^2 x 0.1 mrad x 0.05 s = 0.25 mm/s).
-constexpr double kCloneSpacing_s = 0.1;
+// error state changes little over it (f x phi dt: 50 m/s^2 x 0.1 mrad x 0.1 s = 0.5 mm/s,
+// against the master's 10-50 mm/s). 0.1 s gave the same errors over 50 seeds at 1.15 times
+// the cost (docs/transfer-alignment.md, "Cost").
+constexpr double kCloneSpacing_s = 0.2;
 // History kept beyond |tau| + 4 sigma_tau: room for the delay to grow before the next trim.
 constexpr double kHistoryMargin_s = 0.1;
 // A delay estimate below zero puts the data time after the present: the measurement is then
