@@ -21,7 +21,10 @@
 // the compensation's truncation error, estimated by the first neglected term of the series
 // at tau_eff = |tau| + sigma_tau (order 1: |omega_dot| tau^2/2 and |a| tau + |a_dot| tau^2/2;
 // order 2: |omega_ddot| tau^3/6 and |a_ddot| tau^3/6, third derivatives by a backward
-// difference). On the preset the series' real error is larger still (omega tau to 1.9 rad),
+// difference). That term is not white (it is in phase with the delay's own column), so the
+// filter also accumulates a bound of the bias it leaves in the misalignment and the delay
+// (TransferFilterRun::truncation_bound, filter.h), which the reported sigma carry.
+// On the preset the series' real error is larger still (omega tau to 1.9 rad),
 // and a chi-square gate then rejects the records that carry the delay (the delay is not
 // acquired: delay 3-70 ms at gate probabilities 0.9999 to 0.99999999), so the gate is off (kGateProbability).
 // Whitened and passed to the project's Joseph-form ESKF (solvers/eskf.h). Feedback:
