@@ -128,7 +128,7 @@ const TransferInputs& PresetInputs(double delay_s) {
 }
 
 // The preset (seed 1) at 300 and 450 ms, where the Taylor-series filters fail. Measured:
-// attitude RMS 0.075-0.082 / 0.074-0.078 / 0.044-0.049 mrad, delay error 0.009 ms with sigma
+// attitude RMS 0.075-0.082 / 0.073-0.077 / 0.043-0.048 mrad, delay error 0.009 ms with sigma
 // 0.05 ms, NEES of (misalignment, delay) 3.5-3.6 (without the slave's instrument errors as
 // states it was 104; with scale factors and axis misalignments but not the biases, 6.4-6.5). Tolerances: attitude RMS below 0.5 mrad per axis
 // (order 2 on the preset: 8 / 0.8 / 0.5 mrad), delay within 1 ms (the goal) and
