@@ -23,7 +23,9 @@
 // order 2: |omega_ddot| tau^3/6 and |a_ddot| tau^3/6, third derivatives by a backward
 // difference). That term is not white (it is in phase with the delay's own column), so the
 // filter also accumulates a bound of the bias it leaves in the misalignment and the delay
-// (TransferFilterRun::truncation_bound, filter.h), which the reported sigma carry.
+// (TransferFilterRun::truncation_bound, filter.h), which the reported sigma carry, with
+// the covariance the slave's unmodelled instrument errors leave (a consider analysis,
+// TransferFilterRun::instrument_sensitivity).
 // On the preset the series' real error is larger still (omega tau to 1.9 rad),
 // and a chi-square gate then rejects the records that carry the delay (the delay is not
 // acquired: delay 3-70 ms at gate probabilities 0.9999 to 0.99999999), so the gate is off (kGateProbability).
@@ -77,6 +79,7 @@ class TransferFilter {
         slave_imu_, master_, ins_.state().t_s, [this](const ImuSample& s) { Propagate(s); },
         [this, out](std::size_t k) { Update(k, out); });
     out->truncation_bound = TruncationBound();
+    out->instrument_sensitivity = sensitivity_.middleRows<4>(kMis);
   }
 
  private:
@@ -86,9 +89,11 @@ class TransferFilter {
   }
 
   void Propagate(const ImuSample& s) {
-    const Matrix10 Phi = TransferTransition(ins_.state(), s);
+    InstrumentColumns phi_xi;
+    const Matrix10 Phi = TransferTransition(ins_.state(), s, &phi_xi);
     const Matrix10 Qd = Matrix10((q_ * s.dt_s).asDiagonal());
     kf_.Predict(Phi, Qd);
+    sensitivity_ = Phi.lazyProduct(sensitivity_) + phi_xi;
     ins_.Update(s);
   }
 
@@ -127,6 +132,7 @@ class TransferFilter {
     }
     r = r0;
     AccumulateTruncation(SeriesRemainder(k), sigma, Hw);
+    UpdateSensitivity(Hw);
     const ErrorStateKalmanFilter::Update u = kf_.Correct(y, Hw, kGateProbability);
     const Eigen::VectorXd& dx = u.dx;
     if (!dx.allFinite()) Fail(kin.tag_s, "the state correction");
@@ -213,6 +219,19 @@ class TransferFilter {
     return bound;
   }
 
+  // Consider analysis of the slave's instrument errors p (filter.h,
+  // TransferFilterRun::instrument_sensitivity): the error state's sensitivity S = d dx / d p
+  // moves with the transition, S <- Phi S + Phi_xi, and an update with gain K leaves
+  // (I - K H) S; the prior P (before the update) and the whitened H give K = P H^T (H P H^T + I)^-1,
+  // the gain of the ESKF's Correct that follows (no gate).
+  void UpdateSensitivity(const Eigen::MatrixXd& Hw) {
+    const Eigen::MatrixXd& P = kf_.P();
+    const Eigen::MatrixXd PHt = P * Hw.transpose();
+    const Eigen::MatrixXd S = Hw * PHt + Eigen::MatrixXd::Identity(Hw.rows(), Hw.rows());
+    const Eigen::MatrixXd K = S.ldlt().solve(PHt.transpose()).transpose();
+    sensitivity_ -= K * (Hw * sensitivity_);
+  }
+
   [[noreturn]] static void Fail(double t_s, const char* what) { ThrowNonFinite("RunTransferFilter", t_s, what); }
 
   const TransferConfig& cfg_;
@@ -226,6 +245,7 @@ class TransferFilter {
   const std::vector<ImuSample>& slave_imu_;
   Eigen::Matrix4d truncation_form_ = Eigen::Matrix4d::Zero();  // sum of c c^T / sigma^2
   Eigen::Vector4d information_ = Eigen::Vector4d::Zero();       // sum of |H_(mu, tau) / sigma|^2
+  InstrumentColumns sensitivity_ = InstrumentColumns::Zero();   // d dx / d(instrument errors)
 };
 
 }  // namespace
@@ -272,6 +292,11 @@ void MatchResidualAndJacobian(const Matrix3d& R_n_s, const Vector3d& v_n_s_mps, 
   H->block<3, 3>(3, kAtt) = RightJacobianInverseSO3<double>(-r_att);
   H->block<3, 3>(3, kMis) = -Jr_inv * C;
   H->block<3, 1>(3, kTau) = -Jr_inv * C * u;
+}
+
+Eigen::Matrix4d InstrumentConsiderCovariance(const TransferFilterRun& run, const TransferConfig& config) {
+  const Eigen::Matrix<double, 4, kInstrumentStates>& S = run.instrument_sensitivity;
+  return S * InstrumentPriorSigma(config).cwiseAbs2().asDiagonal() * S.transpose();
 }
 
 TransferFilterRun RunTransferFilter(const TransferInputs& inputs, const TransferConfig& config, DelayOrder order) {

@@ -64,8 +64,21 @@ struct TransferFilterRun {
   /// where the series does not converge (omega tau near 1); the innovations show it there.
   /// Zero for the history filter (no series).
   Eigen::Vector4d truncation_bound = Eigen::Vector4d::Zero();
+  /// Order filters: the sensitivity of the final [mu (3), dtau] to the slave's instrument
+  /// errors p (filter_model.h's 24: scale factors, axis misalignments, biases), which these
+  /// filters do not estimate, through the filter's own transitions and gains — a consider
+  /// analysis (B. D. Tapley, B. E. Schutz, G. H. Born, "Statistical Orbit Determination",
+  /// 2004, section 6.3): an error p moves the estimate by about S p, so the covariance it
+  /// leaves is S P_p S^T (InstrumentConsiderCovariance), which the reported sigma carry.
+  /// Zero for the history filter (it estimates them).
+  Eigen::Matrix<double, 4, kInstrumentStates> instrument_sensitivity =
+      Eigen::Matrix<double, 4, kInstrumentStates>::Zero();
   double run_time_s = 0.0;
 };
+
+/// S P_p S^T of TransferFilterRun::instrument_sensitivity with the configuration's priors
+/// (InstrumentPriorSigma): the covariance of [mu, dtau] the unmodelled instrument errors leave.
+Eigen::Matrix4d InstrumentConsiderCovariance(const TransferFilterRun& run, const TransferConfig& config);
 
 /// The matching residuals of problems/transfer_alignment/delay_model.h at the estimate, r = [VelocityMatchResidual;
 /// AttitudeMatchResidual] (m/s, rad), and their analytic Jacobian H = dr/d(dx) with respect

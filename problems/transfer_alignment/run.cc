@@ -111,16 +111,21 @@ TransferResult RunFilterMethod(const TransferInputs& inputs, const TransferConfi
   }
   r.delay_s = last.delay_s;
   r.misalignment_deg = EulerOf(last.misalignment) * kRadToDeg;
-  // The order filters' sigma carry the series' truncation bounds (filter.h).
+  // The order filters' sigma carry the unmodelled instrument errors and the series'
+  // truncation bounds (filter.h).
   const Eigen::Vector4d& bound = run.truncation_bound;
-  Eigen::Matrix4d covariance = run.misalignment_delay_covariance;
+  const Eigen::Matrix4d instrument = InstrumentConsiderCovariance(run, config);
+  Eigen::Matrix4d covariance = run.misalignment_delay_covariance + instrument;
   covariance.diagonal() += bound.cwiseAbs2();
   const Eigen::Vector4d sigma = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   r.misalignment_sigma_mrad = sigma.head<3>() / kMrad_rad;
   r.delay_sigma_s = sigma(3);
-  if (bound.maxCoeff() > 0.0) {
+  if (method != Method::kHistory) {
     std::ostringstream note;
-    note << "; sigma include the compensation series' truncation bounds: misalignment "
+    note << "; sigma include the slave's unmodelled instrument errors ("
+         << (instrument.diagonal().head<3>().cwiseMax(0.0).cwiseSqrt() / kMrad_rad).transpose()
+         << " mrad, " << std::sqrt(std::max(instrument(3, 3), 0.0)) * 1e3
+         << " ms) and the compensation series' truncation bounds: misalignment "
          << (bound.head<3>() / kMrad_rad).transpose() << " mrad, delay " << bound(3) * 1e3
          << " ms (the covariance alone: " << (last.sigma.segment<3>(6) / kMrad_rad).transpose() << " mrad, "
          << last.sigma[9] * 1e3 << " ms)";
