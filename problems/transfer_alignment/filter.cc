@@ -101,7 +101,8 @@ class TransferFilter {
     const MasterKinematics& kin = master_.kinematics(k);
     NavState s = ins_.state();
     ResetSlavePosition(master_.record(k), tau_s_, &s);
-    const Eigen::Matrix<double, 6, 1> sigma = MeasurementSigma(k);
+    const Remainder remainder = SeriesRemainder(k);
+    const Eigen::Matrix<double, 6, 1> sigma = MeasurementSigma(remainder);
     const Eigen::Matrix<double, 6, 1> inv_sigma = sigma.cwiseInverse();
     // Iterated update (Gauss-Newton on the prior plus this record): relinearise at
     // x0 (+) dx_i; dx_{i+1} = K_i (y_i + H_i dx_i), K_i = P H_i^T (H_i P H_i^T + I)^-1
@@ -131,7 +132,7 @@ class TransferFilter {
       if (!dx_i.allFinite()) Fail(kin.tag_s, "the iterated correction");
     }
     r = r0;
-    AccumulateTruncation(SeriesRemainder(k), sigma, Hw);
+    AccumulateTruncation(remainder, sigma, Hw);
     UpdateSensitivity(Hw);
     const ErrorStateKalmanFilter::Update u = kf_.Correct(y, Hw, kGateProbability);
     const Eigen::VectorXd& dx = u.dx;
@@ -182,15 +183,14 @@ class TransferFilter {
     rem.vel(3) = ((m.a_dot_n_mps3 - p.a_dot_n_mps3) / dt).norm() / 6.0;
     return rem;
   }
-  static Eigen::Vector4d Powers(double tau) { return Eigen::Vector4d(1.0, tau, tau * tau, tau * tau * tau); }
+  static Eigen::Vector4d Powers(double tau_s) { return Eigen::Vector4d(1.0, tau_s, tau_s * tau_s, tau_s * tau_s * tau_s); }
 
-  // Per-axis 1-sigma of the velocity and attitude matching at record k (see the header
+  // Per-axis 1-sigma of the velocity and attitude matching with remainder rem of the record (see the header
   // comment, "measurement noise"): the master's noise, the velocity noise through the
   // differentiator's gain, and the truncation error of the compensation series estimated
   // by its first neglected term at the delay tau_eff = |tau| + sigma_tau.
-  Eigen::Matrix<double, 6, 1> MeasurementSigma(std::size_t k) const {
+  Eigen::Matrix<double, 6, 1> MeasurementSigma(const Remainder& rem) const {
     const double tau = std::abs(tau_s_) + std::sqrt(kf_.P()(kTau, kTau));
-    const Remainder rem = SeriesRemainder(k);
     const double trunc_att = rem.att.dot(Powers(tau)), trunc_vel = rem.vel.dot(Powers(tau));
     // The weights of the v_j in v_k + tau a_k + tau^2/2 a_dot_k (differences or the fit).
     const double gain_v = order_ == DelayOrder::kFirst ? 1.0 : master_.VelocityNoiseGain(tau, order_);

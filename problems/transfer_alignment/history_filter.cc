@@ -33,6 +33,7 @@ using tstate::kTau;
 using tstate::kVel;
 
 constexpr int kCloneSize = 6;  // [dv, phi] of the slave at the clone's time
+constexpr int kClonePhi = 3;   // offset of phi within a clone
 constexpr int kInstr = kTransferStates;                        // offset of the instrument errors
 constexpr int kPresent = kTransferStates + kInstrumentStates;  // the present's block
 using InstrumentVector = InstrumentPrior;  // same shape: the estimates
@@ -52,6 +53,9 @@ constexpr double kHistoryMargin_s = 0.1;
 // present), up to this lead; further, the record is not used.
 constexpr double kMaxLead_s = 0.5;
 
+/// The nominal slave's acceleration over a bracket, NED, m/s^2: (v_n1 - v_n0) / h.
+Vector3d BracketAcceleration(const HistoryBracket& b) { return (b.n1.v_n_mps - b.n0.v_n_mps) / (b.n1.t_s - b.n0.t_s); }
+
 /// Velocity-match variance per NED axis that the linearisation in the delay leaves out: the
 /// delay column carries the nominal slave's acceleration a_s = (v_n1 - v_n0) / h, which
 /// differs from the true one by -[f x] phi (f = a_s - g_n, the specific force, and phi the
@@ -59,11 +63,11 @@ constexpr double kMaxLead_s = 0.5;
 /// errors, has variance sigma_tau^2 diag([f x] P_phi [f x]^T). It matters while both are
 /// large (an acquisition with a precise master: the nominal's own drift would otherwise be
 /// read as motion that fixes the delay) and vanishes as they converge.
-Vector3d DelayLinearisationVariance(const HistoryBracket& b, const Vector3d& g_n, const Matrix3d& P_phi,
-                                    double var_tau) {
-  const Vector3d f_n = (b.n1.v_n_mps - b.n0.v_n_mps) / (b.n1.t_s - b.n0.t_s) - g_n;
-  const Matrix3d F = Skew<double>(f_n);
-  return (F * P_phi * F.transpose()).diagonal() * std::max(var_tau, 0.0);
+/// (m/s)^2 per axis; P_phi_rad2: the attitude error's covariance at the node before s.
+Vector3d DelayLinearisationVariance(const HistoryBracket& b, const Vector3d& g_n_mps2, const Matrix3d& P_phi_rad2,
+                                    double var_tau_s2) {
+  const Matrix3d F = Skew<double>(Vector3d(BracketAcceleration(b) - g_n_mps2));
+  return (F * P_phi_rad2 * F.transpose()).diagonal() * std::max(var_tau_s2, 0.0);
 }
 
 /// Position of s in a sorted sequence of times: the segment [i0, i0 + 1] that holds s, or
@@ -279,7 +283,7 @@ class HistoryFilter {
   bool Correct(const MasterKinematics& kin, Eigen::Matrix<double, 6, 1>* r0, double* nis0) {
     const int N = static_cast<int>(P_.rows());
     const NavState& now = ins_.state();
-    const Vector3d g_n = wgs84::GravityNed(now.lat_rad, now.h_m);
+    const Vector3d g_n_mps2 = wgs84::GravityNed(now.lat_rad, now.h_m);
     Vector6 inv_sigma;
     VectorXd dx = VectorXd::Zero(N);
     MatrixXd PHt(N, 6);
@@ -300,7 +304,7 @@ class HistoryFilter {
       if (it == 0) {
         *r0 = r;
         const Vector3d var_v = Vector3d::Constant(cfg_.master_velocity_mps * cfg_.master_velocity_mps) +
-                               DelayLinearisationVariance(b, g_n, P_.block<3, 3>(o0 + 3, o0 + 3), P_(kTau, kTau));
+                               DelayLinearisationVariance(b, g_n_mps2, P_.block<3, 3>(o0 + kClonePhi, o0 + kClonePhi), P_(kTau, kTau));
         inv_sigma << var_v.cwiseSqrt().cwiseInverse(), Vector3d::Constant(1.0 / cfg_.master_attitude_rad);
       }
       H = inv_sigma.asDiagonal() * H;
@@ -413,7 +417,7 @@ void HistoryMatchResidualAndJacobian(const HistoryBracket& b, const Matrix3d& R_
   const double a = (s - b.n0.t_s) / h;
   const Matrix3d R0 = b.n0.q_n_s.toRotationMatrix();
   const Vector3d omega_s = LogSO3<double>(Matrix3d(R0.transpose() * b.n1.q_n_s.toRotationMatrix())) / h;
-  const Vector3d accel_n = (b.n1.v_n_mps - b.n0.v_n_mps) / h;
+  const Vector3d accel_n = BracketAcceleration(b);
   // Error at s, linear between the error nodes.
   const double ac = (s - b.c0_s) / hc;
   const Vector6 e = b.e0 + ac * (b.e1 - b.e0);
