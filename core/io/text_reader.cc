@@ -32,16 +32,16 @@ char LowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 
 
 }  // namespace
 
-LineReader::LineReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+LineReader::LineReader(const std::string& path)
+    : path_(path), in_(path, std::ios::binary), buf_(new char[kBlockBytes]) {
   if (!in_) throw InputError(path, 0, "", "cannot open the file");
-  buf_.resize(std::size_t{1} << 20);
 }
 
 bool LineReader::Fill() {
   pos_ = 0;
   end_ = 0;
   if (!in_) return false;
-  in_.read(buf_.data(), static_cast<std::streamsize>(buf_.size()));
+  in_.read(buf_.get(), static_cast<std::streamsize>(kBlockBytes));
   end_ = static_cast<std::size_t>(in_.gcount());
   return end_ > 0;
 }
@@ -57,7 +57,7 @@ bool LineReader::Next(std::string* line) {
   bool any = false;
   while (pos_ < end_ || Fill()) {
     any = true;
-    const char* begin = buf_.data() + pos_;
+    const char* begin = buf_.get() + pos_;
     const std::size_t n = end_ - pos_;
     // The first '\n', then a '\r' before it (never scanning past the line's end).
     const char* lf = static_cast<const char*>(std::memchr(begin, '\n', n));

@@ -43,10 +43,10 @@ TEST(TextReaderTest, LineReaderHandlesLfCrLfAndCrEndsAndCountsBytes) {
   EXPECT_FALSE(r.Next(&line));
 }
 
-// The reader takes the file in 1 MiB blocks: a line longer than a block, and a CR LF whose
+// The reader takes the file in blocks: a line longer than a block, and a CR LF whose
 // two bytes fall into two blocks, come out whole, with their byte offsets.
 TEST(TextReaderTest, LinesAcrossBlockBoundariesComeOutWhole) {
-  constexpr std::size_t kBlock = std::size_t{1} << 20;
+  constexpr std::size_t kBlock = LineReader::kBlockBytes;
   const std::string longest(kBlock + 100, 'x');
   const std::string first(kBlock - 2, 'y');  // "y...y\r" ends the first block, "\n" starts the next
   const std::string text = first + "\r\n" + longest + "\nz\r";
