@@ -168,7 +168,8 @@ ErrorStateKalmanFilter::Update ErrorStateKalmanFilter::Correct(const Eigen::Vect
     return u;
   }
   // K = P H^T S^-1 = (S^-1 H P)^T (S and P symmetric).
-  const Eigen::MatrixXd K = llt.solve(PHt.transpose()).transpose();
+  u.K = llt.solve(PHt.transpose()).transpose();
+  const Eigen::MatrixXd& K = u.K;
   u.dx = K * y;
   Eigen::MatrixXd IKH = -K * H;
   IKH.diagonal().array() += 1.0;

@@ -37,6 +37,7 @@ class ErrorStateKalmanFilter {
     double log_det_s = 0.0;  ///< log det S (with nis: -2 log N(y; 0, S) = nis + log det S + m log 2 pi)
     double gate = 0.0;  ///< the chi-square threshold used (inf when not gating)
     Eigen::VectorXd dx; ///< the error-state estimate K y (zero when rejected)
+    Eigen::MatrixXd K;  ///< the gain P H^T S^-1, state size x dim y (empty when rejected)
   };
 
   /// Whitened measurement y = H dx + v, v ~ N(0, I) (y = -r of a whitened residual r).

@@ -93,6 +93,9 @@ class TransferFilter {
     const Matrix10 Phi = TransferTransition(ins_.state(), s, &phi_xi);
     const Matrix10 Qd = Matrix10((q_ * s.dt_s).asDiagonal());
     kf_.Predict(Phi, Qd);
+    // Consider analysis of the slave's instrument errors p (filter.h,
+    // TransferFilterRun::instrument_sensitivity): the sensitivity S = d dx / d p moves with the
+    // transition, S <- Phi S + Phi_xi; an accepted update with gain K leaves (I - K H) S.
     sensitivity_ = Phi.lazyProduct(sensitivity_) + phi_xi;
     ins_.Update(s);
   }
@@ -132,9 +135,11 @@ class TransferFilter {
       if (!dx_i.allFinite()) Fail(kin.tag_s, "the iterated correction");
     }
     r = r0;
-    AccumulateTruncation(remainder, sigma, Hw);
-    UpdateSensitivity(Hw);
     const ErrorStateKalmanFilter::Update u = kf_.Correct(y, Hw, kGateProbability);
+    if (u.accepted) {  // a rejected record moves neither the estimate nor its error terms
+      AccumulateTruncation(remainder, sigma, Hw);
+      sensitivity_ -= u.K * (Hw * sensitivity_);  // S <- (I - K H) S
+    }
     const Eigen::VectorXd& dx = u.dx;
     if (!dx.allFinite()) Fail(kin.tag_s, "the state correction");
     // Feedback (the error state is zero again afterwards).
@@ -217,19 +222,6 @@ class TransferFilter {
       if (information_(i) > 0.0) bound(i) = std::sqrt(remainder / information_(i));
     }
     return bound;
-  }
-
-  // Consider analysis of the slave's instrument errors p (filter.h,
-  // TransferFilterRun::instrument_sensitivity): the error state's sensitivity S = d dx / d p
-  // moves with the transition, S <- Phi S + Phi_xi, and an update with gain K leaves
-  // (I - K H) S; the prior P (before the update) and the whitened H give K = P H^T (H P H^T + I)^-1,
-  // the gain of the ESKF's Correct that follows (no gate).
-  void UpdateSensitivity(const Eigen::MatrixXd& Hw) {
-    const Eigen::MatrixXd& P = kf_.P();
-    const Eigen::MatrixXd PHt = P * Hw.transpose();
-    const Eigen::MatrixXd S = Hw * PHt + Eigen::MatrixXd::Identity(Hw.rows(), Hw.rows());
-    const Eigen::MatrixXd K = S.ldlt().solve(PHt.transpose()).transpose();
-    sensitivity_ -= K * (Hw * sensitivity_);
   }
 
   [[noreturn]] static void Fail(double t_s, const char* what) { ThrowNonFinite("RunTransferFilter", t_s, what); }

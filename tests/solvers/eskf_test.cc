@@ -104,6 +104,10 @@ TEST(ErrorStateKalmanFilter, JosephUpdateEqualsTextbookUpdate) {
   EXPECT_TRUE(std::isinf(u.gate));
   // Entries are O(1..10); both paths round at ~1e-15 relative with condition numbers ~1e2.
   EXPECT_LT((u.dx - dx_ref).cwiseAbs().maxCoeff(), 1e-12);
+  // The gain of the whitened measurement: P H^T L^-T (L^-1 (H P H^T + R) L^-T)^-1 = K_ref L.
+  ASSERT_EQ(u.K.rows(), n);
+  ASSERT_EQ(u.K.cols(), m);
+  EXPECT_LT((u.K - K_ref * L).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_LT((kf.P() - P_ref).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_EQ((kf.P() - kf.P().transpose()).cwiseAbs().maxCoeff(), 0.0);
   // NIS = innovation^T (H P H^T + R)^-1 innovation.
@@ -126,6 +130,7 @@ TEST(ErrorStateKalmanFilter, GateRejectsTenSigmaOutlierAndCountsIt) {
   EXPECT_NEAR(bad.gate, ChiSquareQuantile(0.9999, 3), 1e-12);
   EXPECT_EQ(bad.dx.size(), 3);
   EXPECT_EQ(bad.dx.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(bad.K.size(), 0);  // no gain: nothing was applied
   EXPECT_EQ(kf.P(), Eigen::MatrixXd::Identity(3, 3));  // untouched
   EXPECT_EQ(kf.rejected_count(), 1);
   // A 1-sigma innovation passes; the same outlier without a gate is accepted.
