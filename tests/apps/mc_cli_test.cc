@@ -57,6 +57,19 @@ TEST(McCliTest, LevelingFiguresAreLevelMcs) {
   EXPECT_NEAR(pitch, JsonNumberAfter(level.out, "\"period_average\":{", "pitch_rms_deg"), 1e-9);
 }
 
+// Under AddressSanitizer, Open MPI's own allocations still held at exit (its run-time
+// environment, its progress thread's event loop: about 120 KB in 3,400 blocks per rank) are
+// reported as leaks and would fail the ranks. The suppressions name only Open MPI's libraries;
+// the full unwinder is needed to reach them from code in its plug-ins.
+std::string LeakSuppressionsForOpenMpi() {
+#if defined(__SANITIZE_ADDRESS__)
+  return std::string("LSAN_OPTIONS=\"$LSAN_OPTIONS:suppressions=") + NAVTWIN_SOURCE_DIR +
+         "/tests/apps/lsan_openmpi.supp:fast_unwind_on_malloc=0\" ";
+#else
+  return "";
+#endif
+}
+
 TEST(McCliTest, MpirunWithTwoRanksWritesTheSameBytes) {
 #ifndef NAVTWIN_MPIEXEC
   if (std::getenv("CI") != nullptr) FAIL() << "CI: mpiexec not found at configure time (install openmpi-bin)";
@@ -71,7 +84,7 @@ TEST(McCliTest, MpirunWithTwoRanksWritesTheSameBytes) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // Root needs --allow-run-as-root; two ranks on a small machine need --oversubscribe.
   const std::string log = MakeTempDir("mc_np2_log") + "/log";
-  const std::string cmd = std::string(NAVTWIN_MPIEXEC) + " --allow-run-as-root --oversubscribe --bind-to none -np 2 " +
+  const std::string cmd = LeakSuppressionsForOpenMpi() + std::string(NAVTWIN_MPIEXEC) + " --allow-run-as-root --oversubscribe --bind-to none -np 2 " +
                           NAVTWIN_BIN_DIR + "/navtwin mc --problem leveling --runs 400 --seed 2 --threads 1 --out " +
                           ranks + " >" + log + " 2>&1";
   const int status = std::system(cmd.c_str());
