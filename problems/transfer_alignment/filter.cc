@@ -188,6 +188,8 @@ class TransferFilter {
     rem.vel(3) = ((m.a_dot_n_mps3 - p.a_dot_n_mps3) / dt).norm() / 6.0;
     return rem;
   }
+  // The delay at which the series' remainder is evaluated, tau_eff = |tau| + sigma_tau, s.
+  double EffectiveDelay_s() const { return std::abs(tau_s_) + std::sqrt(std::max(kf_.P()(kTau, kTau), 0.0)); }
   static Eigen::Vector4d Powers(double tau_s) { return Eigen::Vector4d(1.0, tau_s, tau_s * tau_s, tau_s * tau_s * tau_s); }
 
   // Per-axis 1-sigma of the velocity and attitude matching with remainder rem of the record (see the header
@@ -195,7 +197,7 @@ class TransferFilter {
   // differentiator's gain, and the truncation error of the compensation series estimated
   // by its first neglected term at the delay tau_eff = |tau| + sigma_tau.
   Eigen::Matrix<double, 6, 1> MeasurementSigma(const Remainder& rem) const {
-    const double tau = std::abs(tau_s_) + std::sqrt(kf_.P()(kTau, kTau));
+    const double tau = EffectiveDelay_s();
     const double trunc_att = rem.att.dot(Powers(tau)), trunc_vel = rem.vel.dot(Powers(tau));
     // The weights of the v_j in v_k + tau a_k + tau^2/2 a_dot_k (differences or the fit).
     const double gain_v = order_ == DelayOrder::kFirst ? 1.0 : master_.VelocityNoiseGain(tau, order_);
@@ -215,7 +217,7 @@ class TransferFilter {
     information_ += Hw.middleCols<4>(kMis).colwise().squaredNorm().transpose();
   }
   Eigen::Vector4d TruncationBound() const {
-    const Eigen::Vector4d t = Powers(std::abs(tau_s_) + std::sqrt(std::max(kf_.P()(kTau, kTau), 0.0)));
+    const Eigen::Vector4d t = Powers(EffectiveDelay_s());
     const double remainder = std::max(t.dot(truncation_form_ * t), 0.0);
     Eigen::Vector4d bound = Eigen::Vector4d::Zero();
     for (int i = 0; i < 4; ++i) {

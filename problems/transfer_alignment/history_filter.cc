@@ -417,12 +417,12 @@ void HistoryMatchResidualAndJacobian(const HistoryBracket& b, const Matrix3d& R_
   const double a = (s - b.n0.t_s) / h;
   const Matrix3d R0 = b.n0.q_n_s.toRotationMatrix();
   const Vector3d omega_s = LogSO3<double>(Matrix3d(R0.transpose() * b.n1.q_n_s.toRotationMatrix())) / h;
-  const Vector3d accel_n = BracketAcceleration(b);
+  const Vector3d a_n_mps2 = BracketAcceleration(b);
   // Error at s, linear between the error nodes.
   const double ac = (s - b.c0_s) / hc;
   const Vector6 e = b.e0 + ac * (b.e1 - b.e0);
   const Matrix3d R_s = ExpSO3<double>(Vector3d(e.tail<3>())) * R0 * ExpSO3<double>(Vector3d(omega_s * (a * h)));
-  const Vector3d v_s = b.n0.v_n_mps + a * h * accel_n + e.head<3>();
+  const Vector3d v_s = b.n0.v_n_mps + a * h * a_n_mps2 + e.head<3>();
   // The shared model with no carry: the master at its data time.
   Eigen::Matrix<double, 6, kTransferStates> H10;
   MatchResidualAndJacobian(R_s, v_s, R_b_s, m, 0.0, DelayOrder::kFirst, lever_arm_b_m, r, &H10);
@@ -437,7 +437,7 @@ void HistoryMatchResidualAndJacobian(const HistoryBracket& b, const Matrix3d& R_
   // attitude R(s - d) = R(s) Exp(-omega d), which makes E = R_s M^T C^T into E Exp(-C M omega d).
   const Vector6 de_dtau = -(b.e1 - b.e0) / hc;
   Vector6 h_tau = H_e * de_dtau;
-  h_tau.head<3>() -= accel_n;
+  h_tau.head<3>() -= a_n_mps2;
   const Matrix3d C = m.q_n_b.toRotationMatrix();
   h_tau.tail<3>() -= RightJacobianInverseSO3<double>(Vector3d(r->tail<3>())) * (C * R_b_s * omega_s);
   H->col(15) = h_tau;
