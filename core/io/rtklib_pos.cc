@@ -318,13 +318,8 @@ class RtklibPosReader final : public GnssReader {
     *sow = static_cast<double>((days - *week * 7) * kDayWhole_s + hh * 3600 + mm * 60) + ss;
   }
 
-  /// InputError unless 0 <= week <= kMaxGpsWeek.
   void CheckWeek(long long week, long line, const char* field) const {
-    if (week < 0 || week > kMaxGpsWeek) {
-      throw InputError(path(), line, field,
-                       "GPS week " + std::to_string(week) + " outside 0.." +
-                           std::to_string(kMaxGpsWeek) + " (1980-01-06 to 2171)");
-    }
+    CheckGpsWeek(week, path(), line, field);
   }
 
   LineReader lines_;
@@ -357,6 +352,22 @@ GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s) {
   t.week = static_cast<int>(week);
   t.sow_s = static_cast<double>(since_gps_epoch - week * kWeekWhole_s) + fraction_s;
   return t;
+}
+
+GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s, const std::string& path,
+                                long line, const char* field) {
+  if (seconds < 0) throw InputError(path, line, field, "negative time");
+  const std::int64_t since_gps_epoch = seconds - DaysFromCivil(1980, 1, 6) * kDayWhole_s;
+  CheckGpsWeek(FloorDiv(since_gps_epoch, kWeekWhole_s), path, line, field);
+  return GpsTimeFromGpst1970(seconds, fraction_s);
+}
+
+void CheckGpsWeek(long long week, const std::string& path, long line, const char* field) {
+  if (week < 0 || week > kMaxGpsWeek) {
+    throw InputError(path, line, field,
+                     "GPS week " + std::to_string(week) + " outside 0.." + std::to_string(kMaxGpsWeek) +
+                         " (1980-01-06 to 2171)");
+  }
 }
 
 std::unique_ptr<GnssReader> OpenRtklibPos(const std::string& path) {

@@ -38,6 +38,15 @@ std::int64_t DaysFromCivil(int year, int month, int day);
 
 /// GPS week and seconds of week of an instant given like RTKLIB's gtime_t in GPST:
 /// whole seconds since 1970-01-01 00:00:00 counted in the GPS time scale, plus a fraction.
+/// The week must fit an int: readers of outside input use the checked form below.
 GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s);
+
+/// The same, for a time read from `path`: InputError(path, line, field) unless the instant
+/// lies in GPS weeks 0 ... 10000 (1980-01-06 to 2171), the range every reader accepts.
+GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s, const std::string& path,
+                                long line, const char* field);
+
+/// InputError(path, line, field) unless 0 <= week <= 10000.
+void CheckGpsWeek(long long week, const std::string& path, long line, const char* field);
 
 }  // namespace navtwin

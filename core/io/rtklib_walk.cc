@@ -380,8 +380,7 @@ class WalkSfReader final : public ImuReader {
       const std::string digits = "0." + std::string(text.substr(dot + 1));
       fraction = ParseDouble(digits, path(), line(), "time");
     }
-    if (whole < 0) throw InputError(path(), line(), "time", "negative time");
-    const GpsWeekTime t = GpsTimeFromGpst1970(whole, fraction);
+    const GpsWeekTime t = GpsTimeFromGpst1970(whole, fraction, path(), line(), "time");
     if (rows_ == 1) week0_ = t.week;
     return (t.week - week0_) * kSecondsPerWeek + t.sow_s;
   }

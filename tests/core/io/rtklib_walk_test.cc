@@ -155,6 +155,23 @@ TEST(RtklibWalkTest, ValuesThatOverflowInSiUnitsAreRefused) {
   ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImuSf(sf)); }, {sf, "line 2", "field 'az'", "finite"});
 }
 
+TEST(RtklibWalkTest, ConvertedFileTimesOutsideTheGpsWeeksAreRefused) {
+  // A time of 1.7e17 s (a lost decimal point) is GPS week 2.9e11: its week once overflowed
+  // the int subtraction of week numbers (UBSan, found by fuzz_detect_format). Times before
+  // the GPS epoch (1980-01-06, 315964800 s) have negative weeks.
+  const std::string dir = MakeTempDir();
+  const std::string far = dir + "/far_sf.csv";
+  std::ofstream(far) << "175640224096100000,0,0,1,0,0,0.5,0,0,0,0\n"
+                        "1756402240.9670007,0,0,1,0,0,0.5,0,0,0,0\n";
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImuSf(far)); },
+                   {far, "line 1", "field 'time'", "GPS week 290410422916"});
+  const std::string early = dir + "/early_sf.csv";
+  std::ofstream(early) << "1756402240.9610000,0,0,1,0,0,0.5,0,0,0,0\n"
+                          "315964799.5,0,0,1,0,0,0.5,0,0,0,0\n";
+  ExpectInputError([&] { ReadAllSamples(*OpenRtklibWalkImuSf(early)); },
+                   {early, "line 2", "field 'time'", "GPS week -1 outside 0..10000"});
+}
+
 TEST(RtklibWalkTest, BadTagFilesAreRefused) {
   const std::string dir = MakeTempDir();
   Recording rec;
