@@ -259,7 +259,7 @@ class RtklibPosReader final : public GnssReader {
     } else {
       week = ParseInteger(fields_[0], path(), line, "week");
       sow = ParseDouble(fields_[1], path(), line, "tow");
-      CheckWeek(week, line, "week");
+      CheckGpsWeek(week, path(), line, "week");
       if (sow < 0.0 || sow >= kSecondsPerWeek) {
         throw InputError(
             path(), line, "tow",
@@ -314,12 +314,8 @@ class RtklibPosReader final : public GnssReader {
         DaysFromCivil(static_cast<int>(y), static_cast<int>(mo), static_cast<int>(d)) -
         DaysFromCivil(1980, 1, 6);
     *week = FloorDiv(days, 7);
-    CheckWeek(*week, line, "date");
+    CheckGpsWeek(*week, path(), line, "date");
     *sow = static_cast<double>((days - *week * 7) * kDayWhole_s + hh * 3600 + mm * 60) + ss;
-  }
-
-  void CheckWeek(long long week, long line, const char* field) const {
-    CheckGpsWeek(week, path(), line, field);
   }
 
   LineReader lines_;
