@@ -341,21 +341,41 @@ std::int64_t DaysFromCivil(int year, int month, int day) {
   return year_days + day_of_year - 719468;
 }
 
-GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s) {
+namespace {
+
+/// Whole seconds since 1970 in GPST split into the GPS week (64 bits, unchecked) and the
+/// whole seconds into it.
+struct WholeGpsWeekTime {
+  std::int64_t week;
+  std::int64_t sow_whole_s;
+};
+
+WholeGpsWeekTime SplitGpst1970(std::int64_t seconds) {
   const std::int64_t since_gps_epoch = seconds - DaysFromCivil(1980, 1, 6) * kDayWhole_s;
-  GpsWeekTime t;
   const std::int64_t week = FloorDiv(since_gps_epoch, kWeekWhole_s);
-  t.week = static_cast<int>(week);
-  t.sow_s = static_cast<double>(since_gps_epoch - week * kWeekWhole_s) + fraction_s;
+  return {week, since_gps_epoch - week * kWeekWhole_s};
+}
+
+GpsWeekTime ToGpsWeekTime(const WholeGpsWeekTime& w, double fraction_s) {
+  GpsWeekTime t;
+  t.week = static_cast<int>(w.week);
+  t.sow_s = static_cast<double>(w.sow_whole_s) + fraction_s;
   return t;
+}
+
+}  // namespace
+
+GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s) {
+  return ToGpsWeekTime(SplitGpst1970(seconds), fraction_s);
 }
 
 GpsWeekTime GpsTimeFromGpst1970(std::int64_t seconds, double fraction_s, const std::string& path,
                                 long line, const char* field) {
+  // Refused first also because the split below would overflow near INT64_MIN.
   if (seconds < 0) throw InputError(path, line, field, "negative time");
-  const std::int64_t since_gps_epoch = seconds - DaysFromCivil(1980, 1, 6) * kDayWhole_s;
-  CheckGpsWeek(FloorDiv(since_gps_epoch, kWeekWhole_s), path, line, field);
-  return GpsTimeFromGpst1970(seconds, fraction_s);
+  const WholeGpsWeekTime w = SplitGpst1970(seconds);
+  CheckGpsWeek(w.week, path, line, field);
+  return ToGpsWeekTime(w, fraction_s);
 }
 
 void CheckGpsWeek(long long week, const std::string& path, long line, const char* field) {
